@@ -1,0 +1,105 @@
+#include "core/camera_model.h"
+
+#include <cmath>
+
+namespace ceilpose {
+
+bool CameraIntrinsics::has_distortion() const {
+  for (double d : distortion) {
+    if (d != 0.0) return true;
+  }
+  return false;
+}
+
+Mat3 mat_mul(const Mat3& a, const Mat3& b) {
+  Mat3 c{};
+  for (int r = 0; r < 3; ++r)
+    for (int col = 0; col < 3; ++col) {
+      double s = 0.0;
+      for (int k = 0; k < 3; ++k) s += a[r * 3 + k] * b[k * 3 + col];
+      c[r * 3 + col] = s;
+    }
+  return c;
+}
+
+Mat3 mat_transpose(const Mat3& a) {
+  return {a[0], a[3], a[6], a[1], a[4], a[7], a[2], a[5], a[8]};
+}
+
+Vec3 mat_vec(const Mat3& a, const Vec3& v) {
+  return {a[0] * v[0] + a[1] * v[1] + a[2] * v[2], a[3] * v[0] + a[4] * v[1] + a[5] * v[2],
+          a[6] * v[0] + a[7] * v[1] + a[8] * v[2]};
+}
+
+Mat3 tilt_rotation(double tilt_x_rad, double tilt_y_rad) {
+  const double ca = std::cos(tilt_x_rad), sa = std::sin(tilt_x_rad);
+  const double cb = std::cos(tilt_y_rad), sb = std::sin(tilt_y_rad);
+  const Mat3 rx{1, 0, 0, 0, ca, -sa, 0, sa, ca};
+  const Mat3 ry{cb, 0, sb, 0, 1, 0, -sb, 0, cb};
+  return mat_mul(rx, ry);
+}
+
+CameraPose camera_pose_from_robot(const Pose2D& robot, const CameraMount& mount) {
+  const double c = std::cos(robot.yaw_rad), s = std::sin(robot.yaw_rad);
+  CameraPose pose;
+  pose.t_w = {robot.x_m + mount.offset_forward_m * c - mount.offset_left_m * s,
+              robot.y_m + mount.offset_forward_m * s + mount.offset_left_m * c,
+              mount.lens_height_m};
+  const double cam_yaw = robot.yaw_rad + mount.yaw_rad;
+  const double cy = std::cos(cam_yaw), sy = std::sin(cam_yaw);
+  // Columns Xc, Yc, Zc of the level camera (SPEC §3).
+  const Mat3 level{-sy, -cy, 0.0, cy, -sy, 0.0, 0.0, 0.0, 1.0};
+  pose.r_wc = mat_mul(level, tilt_rotation(mount.tilt_x_rad, mount.tilt_y_rad));
+  return pose;
+}
+
+void distort_normalized(const CameraIntrinsics& k, double x, double y, double* xd, double* yd) {
+  const double k1 = k.distortion[0], k2 = k.distortion[1], p1 = k.distortion[2],
+               p2 = k.distortion[3], k3 = k.distortion[4];
+  const double r2 = x * x + y * y;
+  const double radial = 1.0 + r2 * (k1 + r2 * (k2 + r2 * k3));
+  *xd = x * radial + 2.0 * p1 * x * y + p2 * (r2 + 2.0 * x * x);
+  *yd = y * radial + p1 * (r2 + 2.0 * y * y) + 2.0 * p2 * x * y;
+}
+
+bool project_camera_point(const CameraIntrinsics& k, const Vec3& p, double* u_px, double* v_px) {
+  if (p[2] <= 1e-9) return false;
+  double xd = 0.0, yd = 0.0;
+  distort_normalized(k, p[0] / p[2], p[1] / p[2], &xd, &yd);
+  *u_px = k.fx * xd + k.cx;
+  *v_px = k.fy * yd + k.cy;
+  return true;
+}
+
+bool project_world_point(const CameraIntrinsics& k, const CameraPose& pose, const Vec3& pw,
+                         double* u_px, double* v_px) {
+  const Vec3 d{pw[0] - pose.t_w[0], pw[1] - pose.t_w[1], pw[2] - pose.t_w[2]};
+  return project_camera_point(k, mat_vec(mat_transpose(pose.r_wc), d), u_px, v_px);
+}
+
+void undistort_pixel(const CameraIntrinsics& k, double u_px, double v_px, double* x_n,
+                     double* y_n) {
+  const double xd = (u_px - k.cx) / k.fx, yd = (v_px - k.cy) / k.fy;
+  if (!k.has_distortion()) {
+    *x_n = xd;
+    *y_n = yd;
+    return;
+  }
+  const double k1 = k.distortion[0], k2 = k.distortion[1], p1 = k.distortion[2],
+               p2 = k.distortion[3], k3 = k.distortion[4];
+  double x = xd, y = yd;
+  // Fixed-point iteration as in cv::undistortPoints; converges for the mild
+  // distortion of ceiling cameras.
+  for (int i = 0; i < 20; ++i) {
+    const double r2 = x * x + y * y;
+    const double icdist = 1.0 / (1.0 + r2 * (k1 + r2 * (k2 + r2 * k3)));
+    const double dx = 2.0 * p1 * x * y + p2 * (r2 + 2.0 * x * x);
+    const double dy = p1 * (r2 + 2.0 * y * y) + 2.0 * p2 * x * y;
+    x = (xd - dx) * icdist;
+    y = (yd - dy) * icdist;
+  }
+  *x_n = x;
+  *y_n = y;
+}
+
+}  // namespace ceilpose

@@ -1,0 +1,68 @@
+#pragma once
+// The camera model of SPEC §3: OpenCV pinhole + plumb_bob distortion, the
+// camera mounted on the robot looking up, row 0 towards the robot's forward.
+#include <array>
+
+#include "core/pose.h"
+
+namespace ceilpose {
+
+using Vec3 = std::array<double, 3>;
+using Mat3 = std::array<double, 9>;  // row-major
+
+struct CameraIntrinsics {
+  int width = 640;
+  int height = 480;
+  double fx = 530.0;
+  double fy = 530.0;
+  double cx = 319.5;
+  double cy = 239.5;
+  std::array<double, 5> distortion{0.0, 0.0, 0.0, 0.0, 0.0};  // k1 k2 p1 p2 k3
+
+  bool has_distortion() const;
+};
+
+// Where the camera sits on the robot. SPEC defaults: lens 0.3048 m above the
+// floor, at the robot origin, no mounting yaw, no tilt.
+struct CameraMount {
+  double lens_height_m = 0.3048;
+  double offset_forward_m = 0.0;
+  double offset_left_m = 0.0;
+  double yaw_rad = 0.0;         // camera forward (image up) relative to robot forward, CCW
+  double tilt_x_rad = 0.0;      // rotation about the camera's Xc axis (image right)
+  double tilt_y_rad = 0.0;      // rotation about the camera's Yc axis (image down)
+};
+
+// Rigid camera pose in the world: p_world = R_wc * p_cam + t_w.
+struct CameraPose {
+  Mat3 r_wc{};  // columns are the camera axes Xc, Yc, Zc in world coordinates
+  Vec3 t_w{};   // optical centre in the world
+};
+
+// SPEC §3: level camera axes Xc=(-sin yaw, cos yaw, 0), Yc=(-cos yaw, -sin yaw, 0),
+// Zc=(0,0,1), with the mount offset, mounting yaw and tilt applied.
+CameraPose camera_pose_from_robot(const Pose2D& robot, const CameraMount& mount);
+
+// Rotation about Xc by a, then about Yc by b, composed as R = Rx(a) * Ry(b).
+Mat3 tilt_rotation(double tilt_x_rad, double tilt_y_rad);
+
+Mat3 mat_mul(const Mat3& a, const Mat3& b);
+Mat3 mat_transpose(const Mat3& a);
+Vec3 mat_vec(const Mat3& a, const Vec3& v);
+
+// Applies plumb_bob distortion to normalized coordinates (x = Xc/Zc, y = Yc/Zc).
+void distort_normalized(const CameraIntrinsics& k, double x, double y, double* xd, double* yd);
+
+// Camera-frame point to pixel. Returns false when the point is behind the camera.
+bool project_camera_point(const CameraIntrinsics& k, const Vec3& p_cam, double* u_px,
+                          double* v_px);
+
+// World point to pixel for a given camera pose.
+bool project_world_point(const CameraIntrinsics& k, const CameraPose& pose, const Vec3& p_world,
+                         double* u_px, double* v_px);
+
+// Pixel to undistorted normalized coordinates (iterative inverse of plumb_bob,
+// as cv::undistortPoints does).
+void undistort_pixel(const CameraIntrinsics& k, double u_px, double v_px, double* x_n, double* y_n);
+
+}  // namespace ceilpose
