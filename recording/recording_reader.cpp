@@ -1,0 +1,471 @@
+#include "recording/recording_reader.h"
+
+#include <fcntl.h>
+#include <sys/stat.h>
+#include <unistd.h>
+#include <yaml-cpp/yaml.h>
+
+#include <cerrno>
+#include <charconv>
+#include <cmath>
+#include <cstring>
+#include <fstream>
+#include <opencv2/core.hpp>
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
+#include <sstream>
+#include <string_view>
+
+#include "recording/frame_file.h"
+#include "recording/recording_format.h"
+
+namespace ceilpose {
+
+namespace fmt = recording_format;
+
+struct RecordingReader::Scratch {
+  std::vector<uint8_t> file_bytes;  // the encoded frame, reused across frames
+  FrameFileInfo info;
+  cv::Mat decoded;  // decoder output for colour frames (BGR), reused
+};
+
+namespace {
+
+// ---- recording.yaml -------------------------------------------------------
+
+int line_of(const YAML::Node& node) { return node.Mark().line + 1; }
+
+template <typename T>
+Result<T> yaml_scalar(const YAML::Node& parent, const char* key, const std::string& where,
+                      const char* expected) {
+  const YAML::Node node = parent[key];
+  if (!node.IsDefined() || node.IsNull()) {
+    return make_error(where + ":" + std::to_string(line_of(parent)) + ": missing key '" + key +
+                      "'");
+  }
+  T value{};
+  if (!node.IsScalar() || !YAML::convert<T>::decode(node, value)) {
+    return make_error(where + ":" + std::to_string(line_of(node)) + ": key '" + key + "' must be " +
+                      expected);
+  }
+  return value;
+}
+
+Result<double> yaml_finite(const YAML::Node& parent, const char* key, const std::string& where,
+                           bool positive) {
+  auto v = yaml_scalar<double>(parent, key, where, positive ? "a positive number" : "a number");
+  if (!v) return v;
+  if (!std::isfinite(*v) || (positive && *v <= 0.0)) {
+    return make_error(where + ":" + std::to_string(line_of(parent[key])) + ": key '" + key +
+                      "' must be " + (positive ? "a positive number" : "a finite number"));
+  }
+  return v;
+}
+
+Result<RecordingCamera> parse_yaml(const std::string& path) {
+  YAML::Node root;
+  try {
+    root = YAML::LoadFile(path);
+  } catch (const YAML::BadFile&) {
+    std::error_code ec;
+    const bool exists = std::ifstream(path).good();
+    (void)ec;
+    return make_error(path +
+                      (exists ? ": cannot be read" : ": missing (not a recording directory?)"));
+  } catch (const YAML::ParserException& e) {
+    return make_error(path + ":" + std::to_string(e.mark.line + 1) + ":" +
+                      std::to_string(e.mark.column + 1) + ": YAML syntax error: " + e.msg);
+  } catch (const YAML::Exception& e) {
+    return make_error(path + ": YAML error: " + e.what());
+  }
+  if (!root.IsMap()) {
+    return make_error(path + ":1: expected a mapping with keys format, version, camera");
+  }
+  auto format = yaml_scalar<std::string>(root, "format", path, "a string");
+  if (!format) return format.error();
+  if (*format != fmt::kFormat) {
+    return make_error(path + ":" + std::to_string(line_of(root["format"])) + ": format '" +
+                      *format + "' is not '" + fmt::kFormat + "'");
+  }
+  auto version = yaml_scalar<int>(root, "version", path, "an integer");
+  if (!version) return version.error();
+  if (*version != fmt::kVersion) {
+    return make_error(path + ":" + std::to_string(line_of(root["version"])) +
+                      ": unsupported version " + std::to_string(*version) +
+                      " (this reader knows version " + std::to_string(fmt::kVersion) + ")");
+  }
+  const YAML::Node cam = root["camera"];
+  if (!cam.IsDefined() || cam.IsNull()) {
+    return make_error(path + ":" + std::to_string(line_of(root)) + ": missing key 'camera'");
+  }
+  if (!cam.IsMap()) {
+    return make_error(path + ":" + std::to_string(line_of(cam)) +
+                      ": key 'camera' must be a mapping (width, height, fx, fy, cx, cy, "
+                      "distortion)");
+  }
+  RecordingCamera out;
+  CameraIntrinsics& k = out.intrinsics;
+  const std::string cam_where = path;
+  for (auto [key, dst] : {std::pair{"width", &k.width}, std::pair{"height", &k.height}}) {
+    auto v = yaml_scalar<int>(cam, key, cam_where, "a positive integer");
+    if (!v) return v.error();
+    if (*v <= 0) {
+      return make_error(path + ":" + std::to_string(line_of(cam[key])) + ": key 'camera." + key +
+                        "' must be a positive integer, got " + std::to_string(*v));
+    }
+    *dst = *v;
+  }
+  for (auto [key, dst, positive] :
+       {std::tuple{"fx", &k.fx, true}, std::tuple{"fy", &k.fy, true},
+        std::tuple{"cx", &k.cx, false}, std::tuple{"cy", &k.cy, false}}) {
+    auto v = yaml_finite(cam, key, cam_where, positive);
+    if (!v) return v.error();
+    *dst = *v;
+  }
+  // distortion is optional (absent means none), but when present it is
+  // exactly the five plumb_bob coefficients.
+  const YAML::Node dist = cam["distortion"];
+  if (dist.IsDefined() && !dist.IsNull()) {
+    if (!dist.IsSequence() || dist.size() != fmt::kDistortionCoefficients) {
+      return make_error(
+          path + ":" + std::to_string(line_of(dist)) +
+          ": key 'camera.distortion' must be a list of 5 numbers [k1, k2, p1, p2, k3]");
+    }
+    for (int c = 0; c < fmt::kDistortionCoefficients; ++c) {
+      double v = 0.0;
+      if (!dist[c].IsScalar() || !YAML::convert<double>::decode(dist[c], v) || !std::isfinite(v)) {
+        return make_error(path + ":" + std::to_string(line_of(dist[c])) + ": camera.distortion[" +
+                          std::to_string(c) + "] must be a finite number");
+      }
+      k.distortion[static_cast<size_t>(c)] = v;
+    }
+  }
+  const YAML::Node source = root["source"];
+  if (source.IsDefined() && !source.IsNull()) {
+    if (!source.IsScalar()) {
+      return make_error(path + ":" + std::to_string(line_of(source)) +
+                        ": key 'source' must be a string");
+    }
+    out.source = source.Scalar();
+  }
+  return out;
+}
+
+// ---- frames.csv -----------------------------------------------------------
+
+std::string_view trim(std::string_view s) {
+  while (!s.empty() && (s.front() == ' ' || s.front() == '\t')) s.remove_prefix(1);
+  while (!s.empty() && (s.back() == ' ' || s.back() == '\t' || s.back() == '\r'))
+    s.remove_suffix(1);
+  return s;
+}
+
+// Splits one CSV line (RFC 4180 quoting, no embedded newlines). Returns false
+// on an unterminated quote.
+bool split_csv(std::string_view line, std::vector<std::string>* fields) {
+  fields->clear();
+  std::string cur;
+  bool quoted = false;
+  bool was_quoted = false;
+  for (size_t i = 0; i < line.size(); ++i) {
+    const char c = line[i];
+    if (quoted) {
+      if (c == '"') {
+        if (i + 1 < line.size() && line[i + 1] == '"') {
+          cur += '"';
+          ++i;
+        } else {
+          quoted = false;
+        }
+      } else {
+        cur += c;
+      }
+    } else if (c == '"' && trim(cur).empty()) {
+      cur.clear();
+      quoted = true;
+      was_quoted = true;
+    } else if (c == ',') {
+      fields->push_back(was_quoted ? cur : std::string(trim(cur)));
+      cur.clear();
+      was_quoted = false;
+    } else {
+      cur += c;
+    }
+  }
+  if (quoted) return false;
+  fields->push_back(was_quoted ? cur : std::string(trim(cur)));
+  return true;
+}
+
+bool parse_int64(std::string_view s, int64_t* out) {
+  if (s.empty()) return false;
+  const auto [p, ec] = std::from_chars(s.data(), s.data() + s.size(), *out);
+  return ec == std::errc{} && p == s.data() + s.size();
+}
+
+bool parse_double(std::string_view s, double* out) {
+  if (s.empty()) return false;
+  if (s.front() == '+') s.remove_prefix(1);
+  const auto [p, ec] = std::from_chars(s.data(), s.data() + s.size(), *out);
+  return ec == std::errc{} && p == s.data() + s.size() && std::isfinite(*out);
+}
+
+struct Columns {
+  int index = -1, timestamp = -1, file = -1, gt_x = -1, gt_y = -1, gt_yaw = -1;
+  size_t count = 0;
+};
+
+Result<Columns> parse_header(const std::vector<std::string>& names, const std::string& where) {
+  Columns c;
+  c.count = names.size();
+  const std::pair<const char*, int*> known[] = {{"index", &c.index}, {"timestamp_ns", &c.timestamp},
+                                                {"file", &c.file},   {"gt_x_m", &c.gt_x},
+                                                {"gt_y_m", &c.gt_y}, {"gt_yaw_rad", &c.gt_yaw}};
+  for (size_t i = 0; i < names.size(); ++i) {
+    for (const auto& [name, slot] : known) {
+      if (names[i] != name) continue;
+      if (*slot >= 0) {
+        return make_error(where + ":1: column '" + name + "' appears twice in the header");
+      }
+      *slot = static_cast<int>(i);
+    }
+  }
+  for (const auto& [name, slot] : {known[0], known[1], known[2]}) {
+    if (*slot < 0) {
+      return make_error(where + ":1: header lacks the required column '" + name +
+                        "' (need index,timestamp_ns,file)");
+    }
+  }
+  const int gt = (c.gt_x >= 0) + (c.gt_y >= 0) + (c.gt_yaw >= 0);
+  if (gt != 0 && gt != 3) {
+    return make_error(where +
+                      ":1: ground truth needs all three columns gt_x_m, gt_y_m, gt_yaw_rad");
+  }
+  return c;
+}
+
+Result<std::string> read_text(const std::string& path, const char* what) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) {
+    struct stat st {};
+    if (::stat(path.c_str(), &st) != 0 && errno == ENOENT) return make_error(path + ": missing");
+    return make_error(path + ": cannot be read (" + what + ")");
+  }
+  std::ostringstream ss;
+  ss << in.rdbuf();
+  if (in.bad()) return make_error(path + ": read error");
+  return ss.str();
+}
+
+}  // namespace
+
+RecordingReader::RecordingReader() : scratch_(std::make_unique<Scratch>()) {}
+RecordingReader::RecordingReader(RecordingReader&&) noexcept = default;
+RecordingReader& RecordingReader::operator=(RecordingReader&&) noexcept = default;
+RecordingReader::~RecordingReader() = default;
+
+Result<RecordingReader> RecordingReader::open(const std::string& dir) {
+  struct stat st {};
+  if (::stat(dir.c_str(), &st) != 0) {
+    return make_error(dir + ": recording directory does not exist (" + std::strerror(errno) + ")");
+  }
+  if (!S_ISDIR(st.st_mode)) return make_error(dir + ": not a directory");
+
+  RecordingReader r;
+  r.dir_ = dir;
+  while (r.dir_.size() > 1 && r.dir_.back() == '/') r.dir_.pop_back();
+  auto camera = parse_yaml(r.dir_ + "/" + fmt::kYamlName);
+  if (!camera) return camera.error();
+  r.camera_ = std::move(*camera);
+
+  const std::string csv_path = r.dir_ + "/" + fmt::kCsvName;
+  auto text = read_text(csv_path, "frames.csv");
+  if (!text) return text.error();
+  const std::string_view all(*text);
+
+  std::vector<std::string> fields;
+  Columns cols;
+  bool header_seen = false;
+  int line_no = 0;
+  int blank_line = 0;  // first blank line since the last row; only allowed at the end
+  size_t pos = 0;
+  while (pos < all.size()) {
+    size_t eol = all.find('\n', pos);
+    if (eol == std::string_view::npos) eol = all.size();
+    const std::string_view line = trim(all.substr(pos, eol - pos));
+    pos = eol + 1;
+    ++line_no;
+    const std::string where = csv_path + ":" + std::to_string(line_no);
+    if (line.empty()) {
+      if (blank_line == 0) blank_line = line_no;
+      continue;
+    }
+    if (blank_line != 0) {
+      return make_error(csv_path + ":" + std::to_string(blank_line) +
+                        ": empty line before the end of the file");
+    }
+    if (!split_csv(line, &fields)) return make_error(where + ": unterminated quoted field");
+    if (!header_seen) {
+      auto c = parse_header(fields, csv_path);
+      if (!c) return c.error();
+      cols = *c;
+      header_seen = true;
+      r.has_ground_truth_columns_ = cols.gt_x >= 0;
+      continue;
+    }
+    if (fields.size() != cols.count) {
+      return make_error(where + ": " + std::to_string(fields.size()) + " fields, the header has " +
+                        std::to_string(cols.count));
+    }
+    RecordingRow row;
+    row.csv_line = line_no;
+    if (!parse_int64(fields[cols.index], &row.index)) {
+      return make_error(where + ": index '" + fields[cols.index] + "' is not an integer");
+    }
+    const int64_t expected_index = static_cast<int64_t>(r.rows_.size());
+    if (row.index != expected_index) {
+      return make_error(where + ": index " + std::to_string(row.index) +
+                        " out of sequence (expected " + std::to_string(expected_index) +
+                        "; indices count from 0 without gaps)");
+    }
+    if (!parse_int64(fields[cols.timestamp], &row.timestamp_ns)) {
+      return make_error(where + ": timestamp_ns '" + fields[cols.timestamp] +
+                        "' is not an integer");
+    }
+    if (!r.rows_.empty() && row.timestamp_ns < r.rows_.back().timestamp_ns) {
+      return make_error(where + ": timestamp_ns " + std::to_string(row.timestamp_ns) +
+                        " goes backwards (previous " + std::to_string(r.rows_.back().timestamp_ns) +
+                        ")");
+    }
+    row.file = fields[cols.file];
+    if (row.file.empty()) return make_error(where + ": empty file name");
+    if (row.file.front() == '/') {
+      return make_error(where + ": file '" + row.file +
+                        "' must be relative to the recording directory");
+    }
+    if (r.has_ground_truth_columns_) {
+      const std::string& gx = fields[cols.gt_x];
+      const std::string& gy = fields[cols.gt_y];
+      const std::string& gyaw = fields[cols.gt_yaw];
+      // All three empty: this frame has no ground truth (e.g. a tracker lost it).
+      if (!(gx.empty() && gy.empty() && gyaw.empty())) {
+        for (auto [name, text, dst] :
+             {std::tuple{"gt_x_m", &gx, &row.ground_truth.x_m},
+              std::tuple{"gt_y_m", &gy, &row.ground_truth.y_m},
+              std::tuple{"gt_yaw_rad", &gyaw, &row.ground_truth.yaw_rad}}) {
+          if (!parse_double(*text, dst)) {
+            return make_error(where + ": " + name + " '" + *text + "' is not a finite number");
+          }
+        }
+        row.has_ground_truth = true;
+      }
+    }
+    const std::string frame_path = r.dir_ + "/" + row.file;
+    struct stat fst {};
+    if (::stat(frame_path.c_str(), &fst) != 0) {
+      return make_error(frame_path + " (frames.csv:" + std::to_string(line_no) +
+                        "): frame file missing (" + std::strerror(errno) + ")");
+    }
+    if (!S_ISREG(fst.st_mode)) {
+      return make_error(frame_path + " (frames.csv:" + std::to_string(line_no) +
+                        "): not a regular file");
+    }
+    r.rows_.push_back(std::move(row));
+  }
+  if (!header_seen) return make_error(csv_path + ":1: empty file, expected the header line");
+  return r;
+}
+
+std::string RecordingReader::frame_context(size_t i) const {
+  if (i >= rows_.size()) return dir_ + ": frame " + std::to_string(i);
+  return dir_ + "/" + rows_[i].file + " (frames.csv:" + std::to_string(rows_[i].csv_line) + ")";
+}
+
+Result<void> RecordingReader::read_frame_file(size_t i) const {
+  if (i >= rows_.size()) {
+    return make_error(dir_ + ": frame " + std::to_string(i) + " out of range (recording has " +
+                      std::to_string(rows_.size()) + " frames)");
+  }
+  const std::string path = dir_ + "/" + rows_[i].file;
+  const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
+  if (fd < 0) {
+    return make_error(frame_context(i) + ": cannot open frame file (" + std::strerror(errno) + ")");
+  }
+  struct stat st {};
+  if (::fstat(fd, &st) != 0) {
+    const int err = errno;
+    ::close(fd);
+    return make_error(frame_context(i) + ": cannot stat frame file (" + std::strerror(err) + ")");
+  }
+  auto& bytes = scratch_->file_bytes;
+  bytes.resize(static_cast<size_t>(st.st_size));
+  size_t done = 0;
+  while (done < bytes.size()) {
+    const ssize_t n = ::read(fd, bytes.data() + done, bytes.size() - done);
+    if (n < 0 && errno == EINTR) continue;
+    if (n <= 0) {
+      const int err = n < 0 ? errno : 0;
+      ::close(fd);
+      return make_error(
+          frame_context(i) + ": read error" +
+          (err ? std::string(" (") + std::strerror(err) + ")" : std::string(" (file shrank)")));
+    }
+    done += static_cast<size_t>(n);
+  }
+  ::close(fd);
+
+  auto info = inspect_frame_bytes(bytes.data(), bytes.size());
+  if (!info) return make_error(frame_context(i) + ": " + info.error().message);
+  auto supported = check_supported_frame(*info);
+  if (!supported) return make_error(frame_context(i) + ": " + supported.error().message);
+  const CameraIntrinsics& k = camera_.intrinsics;
+  if (info->width != k.width || info->height != k.height) {
+    return make_error(frame_context(i) + ": image is " + std::to_string(info->width) + "x" +
+                      std::to_string(info->height) + ", recording.yaml says " +
+                      std::to_string(k.width) + "x" + std::to_string(k.height));
+  }
+  scratch_->info = *info;
+  return {};
+}
+
+Result<void> RecordingReader::check_frame(size_t i) const { return read_frame_file(i); }
+
+Result<void> RecordingReader::load_frame(size_t i, Image* out) const {
+  auto read = read_frame_file(i);
+  if (!read) return read;
+  const auto& bytes = scratch_->file_bytes;
+  const FrameFileInfo& info = scratch_->info;
+  const cv::Mat encoded(1, static_cast<int>(bytes.size()), CV_8UC1,
+                        const_cast<uint8_t*>(bytes.data()));
+  // Grey frames decode straight into `out`; colour frames go through the
+  // reused BGR buffer because OpenCV decodes to BGR and we hand out RGB.
+  try {
+    if (info.channels == 1) {
+      out->resize(info.width, info.height, PixelFormat::kGray8);
+      cv::Mat dst(info.height, info.width, CV_8UC1, out->data());
+      cv::imdecode(encoded, cv::IMREAD_UNCHANGED, &dst);
+      if (dst.data != out->data() || dst.type() != CV_8UC1 || dst.cols != info.width ||
+          dst.rows != info.height) {
+        return make_error(frame_context(i) + ": corrupt " + to_string(info.encoding) +
+                          " data (decoder failed)");
+      }
+    } else {
+      cv::Mat& bgr = scratch_->decoded;
+      const cv::Mat result = cv::imdecode(encoded, cv::IMREAD_UNCHANGED, &bgr);
+      if (result.empty() || bgr.type() != CV_8UC3 || bgr.cols != info.width ||
+          bgr.rows != info.height) {
+        return make_error(frame_context(i) + ": corrupt " + to_string(info.encoding) +
+                          " data (decoder failed)");
+      }
+      out->resize(info.width, info.height, PixelFormat::kRgb24);
+      cv::Mat dst(info.height, info.width, CV_8UC3, out->data());
+      cv::cvtColor(bgr, dst, cv::COLOR_BGR2RGB);
+    }
+  } catch (const cv::Exception& e) {
+    return make_error(frame_context(i) + ": corrupt " + to_string(info.encoding) + " data (" +
+                      e.what() + ")");
+  }
+  return {};
+}
+
+}  // namespace ceilpose

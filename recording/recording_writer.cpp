@@ -1,0 +1,289 @@
+#include "recording/recording_writer.h"
+
+#include <fcntl.h>
+#include <unistd.h>
+
+#include <array>
+#include <cerrno>
+#include <charconv>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <filesystem>
+#include <opencv2/core.hpp>
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
+#include <vector>
+
+#include "recording/frame_file.h"
+#include "recording/recording_format.h"
+
+namespace ceilpose {
+
+namespace fmt = recording_format;
+
+namespace {
+
+struct FileCloser {
+  void operator()(std::FILE* f) const {
+    if (f != nullptr) std::fclose(f);
+  }
+};
+using FilePtr = std::unique_ptr<std::FILE, FileCloser>;
+
+// Shortest text that reads back to the same double, so rows round-trip exactly.
+std::string number_text(double v) {
+  std::array<char, 32> buf{};
+  const auto [p, ec] = std::to_chars(buf.data(), buf.data() + buf.size(), v);
+  (void)ec;  // 32 chars always hold a double's shortest form
+  return std::string(buf.data(), p);
+}
+
+std::string yaml_quoted(const std::string& s) {
+  std::string out = "\"";
+  for (const char c : s) {
+    if (c == '"' || c == '\\') {
+      out += '\\';
+      out += c;
+    } else if (static_cast<unsigned char>(c) < 0x20) {
+      char esc[8];
+      std::snprintf(esc, sizeof esc, "\\x%02x",
+                    static_cast<unsigned>(static_cast<unsigned char>(c)));
+      out += esc;
+    } else {
+      out += c;
+    }
+  }
+  return out + "\"";
+}
+
+std::string yaml_text(const RecordingCamera& camera) {
+  const CameraIntrinsics& k = camera.intrinsics;
+  std::string y;
+  y += std::string("format: ") + fmt::kFormat + "\n";
+  y += "version: " + std::to_string(fmt::kVersion) + "\n";
+  y += "camera:\n";
+  y += "  width: " + std::to_string(k.width) + "\n";
+  y += "  height: " + std::to_string(k.height) + "\n";
+  y += "  fx: " + number_text(k.fx) + "\n";
+  y += "  fy: " + number_text(k.fy) + "\n";
+  y += "  cx: " + number_text(k.cx) + "\n";
+  y += "  cy: " + number_text(k.cy) + "\n";
+  y += "  distortion: [";
+  for (size_t c = 0; c < k.distortion.size(); ++c) {
+    if (c > 0) y += ", ";
+    y += number_text(k.distortion[c]);
+  }
+  y += "]   # k1 k2 p1 p2 k3\n";
+  if (!camera.source.empty()) y += "source: " + yaml_quoted(camera.source) + "\n";
+  return y;
+}
+
+Result<void> write_file(const std::string& path, const void* data, size_t size) {
+  const int fd = ::open(path.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
+  if (fd < 0) return make_error(path + ": cannot create (" + std::strerror(errno) + ")");
+  const auto* p = static_cast<const uint8_t*>(data);
+  size_t done = 0;
+  while (done < size) {
+    const ssize_t n = ::write(fd, p + done, size - done);
+    if (n < 0 && errno == EINTR) continue;
+    if (n < 0) {
+      const int err = errno;
+      ::close(fd);
+      return make_error(path + ": write error (" + std::strerror(err) + ")");
+    }
+    done += static_cast<size_t>(n);
+  }
+  if (::close(fd) != 0) return make_error(path + ": close error (" + std::strerror(errno) + ")");
+  return {};
+}
+
+}  // namespace
+
+struct RecordingWriter::State {
+  std::string dir;
+  RecordingCamera camera;
+  FilePtr csv;
+  size_t frames = 0;
+  int64_t last_timestamp_ns = 0;
+  bool ground_truth_columns = false;
+  bool closed = false;
+  std::vector<uint8_t> encoded;  // reused encoder output
+  cv::Mat bgr;                   // reused RGB->BGR conversion buffer
+  std::vector<int> encode_params;
+  std::string row;  // reused CSV row text
+};
+
+RecordingWriter::RecordingWriter() : s_(std::make_unique<State>()) {}
+RecordingWriter::RecordingWriter(RecordingWriter&&) noexcept = default;
+RecordingWriter& RecordingWriter::operator=(RecordingWriter&&) noexcept = default;
+RecordingWriter::~RecordingWriter() = default;
+
+size_t RecordingWriter::frames_written() const { return s_ ? s_->frames : 0; }
+
+Result<RecordingWriter> RecordingWriter::create(const std::string& dir,
+                                                const RecordingCamera& camera) {
+  namespace fs = std::filesystem;
+  const CameraIntrinsics& k = camera.intrinsics;
+  if (k.width <= 0 || k.height <= 0 || !(k.fx > 0.0) || !(k.fy > 0.0) || !std::isfinite(k.fx) ||
+      !std::isfinite(k.fy) || !std::isfinite(k.cx) || !std::isfinite(k.cy)) {
+    return make_error(dir + ": invalid camera for a recording (size " + std::to_string(k.width) +
+                      "x" + std::to_string(k.height) + ", fx/fy must be positive and finite)");
+  }
+  for (const double d : k.distortion) {
+    if (!std::isfinite(d)) return make_error(dir + ": camera distortion must be finite");
+  }
+  std::error_code ec;
+  const fs::path root(dir);
+  if (fs::exists(root, ec)) {
+    if (!fs::is_directory(root, ec)) return make_error(dir + ": exists and is not a directory");
+    if (!fs::is_empty(root, ec)) {
+      return make_error(dir + ": directory is not empty; refusing to write a recording into it");
+    }
+  }
+  fs::create_directories(root / fmt::kFramesDir, ec);
+  if (ec)
+    return make_error(dir + ": cannot create " + fmt::kFramesDir + "/ (" + ec.message() + ")");
+
+  RecordingWriter w;
+  w.s_->dir = dir;
+  w.s_->camera = camera;
+  const std::string yaml = yaml_text(camera);
+  auto wrote = write_file(dir + "/" + fmt::kYamlName, yaml.data(), yaml.size());
+  if (!wrote) return wrote.error();
+  const std::string csv_path = dir + "/" + fmt::kCsvName;
+  w.s_->csv.reset(std::fopen(csv_path.c_str(), "we"));
+  if (!w.s_->csv) return make_error(csv_path + ": cannot create (" + std::strerror(errno) + ")");
+  return w;
+}
+
+Result<void> RecordingWriter::append(const ImageView& frame, int64_t timestamp_ns,
+                                     const Pose2D* ground_truth, int jpeg_quality) {
+  if (!s_ || s_->closed) return make_error("recording writer: append() after close()");
+  State& s = *s_;
+  const std::string frame_name = "frame " + std::to_string(s.frames) + " of " + s.dir;
+  if (frame.data == nullptr) return make_error(frame_name + ": empty image");
+  const CameraIntrinsics& k = s.camera.intrinsics;
+  if (frame.width != k.width || frame.height != k.height) {
+    return make_error(frame_name + ": image is " + std::to_string(frame.width) + "x" +
+                      std::to_string(frame.height) + ", the recording's camera is " +
+                      std::to_string(k.width) + "x" + std::to_string(k.height));
+  }
+  if (s.frames > 0 && timestamp_ns < s.last_timestamp_ns) {
+    return make_error(frame_name + ": timestamp_ns " + std::to_string(timestamp_ns) +
+                      " goes backwards (previous " + std::to_string(s.last_timestamp_ns) + ")");
+  }
+  if (s.frames == 0) s.ground_truth_columns = ground_truth != nullptr;
+  if ((ground_truth != nullptr) != s.ground_truth_columns) {
+    return make_error(frame_name + (s.ground_truth_columns
+                                        ? ": no ground truth, but the first frame had it"
+                                        : ": has ground truth, but the first frame had none"));
+  }
+  if (ground_truth != nullptr &&
+      !(std::isfinite(ground_truth->x_m) && std::isfinite(ground_truth->y_m) &&
+        std::isfinite(ground_truth->yaw_rad))) {
+    return make_error(frame_name + ": ground truth is not finite");
+  }
+  if (jpeg_quality < 0 || jpeg_quality > 100) {
+    return make_error(frame_name + ": jpeg_quality " + std::to_string(jpeg_quality) +
+                      " outside 0..100 (0 writes PNG)");
+  }
+
+  const uint8_t* bytes = nullptr;
+  size_t size = 0;
+  bool jpeg = jpeg_quality > 0;
+  if (frame.format == PixelFormat::kMjpeg) {
+    // Stored as the camera delivered it; checked so the recording stays readable.
+    auto info = inspect_frame_bytes(frame.data, frame.size_bytes);
+    if (!info || info->encoding != FrameEncoding::kJpeg) {
+      return make_error(frame_name + ": MJPEG payload is not a complete JPEG" +
+                        (info ? std::string() : " (" + info.error().message + ")"));
+    }
+    if (info->width != k.width || info->height != k.height) {
+      return make_error(frame_name + ": MJPEG payload is " + std::to_string(info->width) + "x" +
+                        std::to_string(info->height) + ", the recording's camera is " +
+                        std::to_string(k.width) + "x" + std::to_string(k.height));
+    }
+    bytes = frame.data;
+    size = frame.size_bytes;
+    jpeg = true;
+  } else {
+    cv::Mat src;
+    switch (frame.format) {
+      case PixelFormat::kGray8:
+        src = cv::Mat(frame.height, frame.width, CV_8UC1, const_cast<uint8_t*>(frame.data),
+                      static_cast<size_t>(frame.stride_bytes));
+        break;
+      case PixelFormat::kBgr24:
+        src = cv::Mat(frame.height, frame.width, CV_8UC3, const_cast<uint8_t*>(frame.data),
+                      static_cast<size_t>(frame.stride_bytes));
+        break;
+      case PixelFormat::kRgb24:
+        cv::cvtColor(cv::Mat(frame.height, frame.width, CV_8UC3, const_cast<uint8_t*>(frame.data),
+                             static_cast<size_t>(frame.stride_bytes)),
+                     s.bgr, cv::COLOR_RGB2BGR);
+        src = s.bgr;
+        break;
+      default:
+        return make_error(frame_name + ": cannot store pixel format " + to_string(frame.format) +
+                          " (RGB24, BGR24, GREY or MJPEG)");
+    }
+    s.encode_params.clear();
+    if (jpeg) {
+      s.encode_params = {cv::IMWRITE_JPEG_QUALITY, jpeg_quality};
+    } else {
+      // Fastest zlib level: a live recorder must keep up with the camera.
+      s.encode_params = {cv::IMWRITE_PNG_COMPRESSION, 1};
+    }
+    try {
+      if (!cv::imencode(jpeg ? ".jpg" : ".png", src, s.encoded, s.encode_params)) {
+        return make_error(frame_name + ": encoder failed");
+      }
+    } catch (const cv::Exception& e) {
+      return make_error(frame_name + ": encoder failed (" + e.what() + ")");
+    }
+    bytes = s.encoded.data();
+    size = s.encoded.size();
+  }
+
+  char name[32];
+  std::snprintf(name, sizeof name, "%s/%06zu.%s", fmt::kFramesDir, s.frames, jpeg ? "jpg" : "png");
+  auto wrote = write_file(s.dir + "/" + name, bytes, size);
+  if (!wrote) return wrote;
+
+  if (s.frames == 0) {
+    std::fputs(s.ground_truth_columns ? "index,timestamp_ns,file,gt_x_m,gt_y_m,gt_yaw_rad\n"
+                                      : "index,timestamp_ns,file\n",
+               s.csv.get());
+  }
+  s.row = std::to_string(s.frames) + "," + std::to_string(timestamp_ns) + "," + name;
+  if (ground_truth != nullptr) {
+    for (const double v : {ground_truth->x_m, ground_truth->y_m, ground_truth->yaw_rad}) {
+      s.row += ',';
+      s.row += number_text(v);
+    }
+  }
+  s.row += "\n";
+  if (std::fputs(s.row.c_str(), s.csv.get()) < 0) {
+    return make_error(s.dir + "/" + fmt::kCsvName + ": write error (" + std::strerror(errno) + ")");
+  }
+  s.last_timestamp_ns = timestamp_ns;
+  ++s.frames;
+  return {};
+}
+
+Result<void> RecordingWriter::close() {
+  if (!s_ || s_->closed) return {};
+  State& s = *s_;
+  s.closed = true;
+  const std::string csv_path = s.dir + "/" + fmt::kCsvName;
+  if (s.frames == 0) std::fputs("index,timestamp_ns,file\n", s.csv.get());
+  const bool failed = std::ferror(s.csv.get()) != 0;
+  std::FILE* f = s.csv.release();
+  if (std::fclose(f) != 0 || failed) {
+    return make_error(csv_path + ": write error (" + std::strerror(errno) + ")");
+  }
+  return {};
+}
+
+}  // namespace ceilpose
