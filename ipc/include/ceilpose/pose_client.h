@@ -1,0 +1,213 @@
+/* ceilpose pose client: read the robot pose that ceilposed publishes in POSIX
+ * shared memory (default segment "/ceilpose"), from C or C++.
+ *
+ *   ceilpose_client* c = NULL;
+ *   if (ceilpose_client_open("/ceilpose", &c) != CEILPOSE_OK) {
+ *     fprintf(stderr, "%s\n", ceilpose_last_error_message());
+ *   }
+ *   ceilpose_pose p;
+ *   uint64_t seq = 0;
+ *   while (ceilpose_client_wait_next(c, seq, 1000, &p) == CEILPOSE_OK) seq = p.seq;
+ *   ceilpose_client_close(c);
+ *
+ * Build with `pkg-config --cflags --libs ceilpose-client`. The records below are
+ * the exact bytes of the shared segment (ABI version CEILPOSE_CLIENT_ABI_VERSION);
+ * the daemon (C++) includes this header too, so both sides share one layout.
+ *
+ * Threads: a handle may be used by one thread at a time; distinct handles are
+ * independent. No call allocates or blocks except open/reattach (allocate) and
+ * wait_next (blocks up to its timeout). docs/ipc.md describes the segment.
+ */
+#ifndef CEILPOSE_POSE_CLIENT_H
+#define CEILPOSE_POSE_CLIENT_H
+
+#include <stddef.h> /* offsetof, for the layout checks below */
+#include <stdint.h>
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/* Version of the shared-segment layout and of these records. A reader refuses
+ * a segment of another version (CEILPOSE_ERR_ABI_MISMATCH). */
+#define CEILPOSE_CLIENT_ABI_VERSION 1
+/* Default segment name (SPEC §7: --shm defaults to /ceilpose). */
+#define CEILPOSE_DEFAULT_SHM_NAME "/ceilpose"
+/* Poses kept in the segment's ring of recent poses. */
+#define CEILPOSE_POSE_RING_LENGTH 64
+#define CEILPOSE_SOURCE_TEXT_SIZE 96
+
+/* ceilpose_pose.flags */
+#define CEILPOSE_POSE_VALID 0x1u    /* x_m, y_m, yaw_rad and covariance hold a pose */
+#define CEILPOSE_POSE_FILTERED 0x2u /* the temporal filter produced this pose */
+#define CEILPOSE_POSE_COASTING 0x4u /* predicted: no marker fix in this frame */
+
+/* ceilpose_pose.mode: the positioning method used (SPEC §5 "mode" names). */
+enum ceilpose_mode {
+  CEILPOSE_MODE_AUTO = 0,        /* "auto" */
+  CEILPOSE_MODE_AXES = 1,        /* "axes": change of axes */
+  CEILPOSE_MODE_BARYCENTRIC = 2, /* "barycentric" */
+  CEILPOSE_MODE_LSQ = 3          /* "lsq": least squares over all markers */
+};
+
+/* ceilpose_status.fix_state */
+enum ceilpose_fix_state {
+  CEILPOSE_FIX_NONE = 0,     /* no pose since start */
+  CEILPOSE_FIX_OK = 1,       /* last frame gave a pose */
+  CEILPOSE_FIX_COASTING = 2, /* recent fix, current poses predicted */
+  CEILPOSE_FIX_LOST = 3      /* no fix for longer than the filter coasts */
+};
+
+/* One published pose. Times: *_mono_ns on CLOCK_MONOTONIC, *_real_ns on
+ * CLOCK_REALTIME, both in nanoseconds. */
+typedef struct ceilpose_pose {
+  uint64_t seq;            /* 1, 2, 3, ... per writer generation; 0 = none */
+  int64_t capture_mono_ns; /* when the camera captured the frame */
+  int64_t capture_real_ns;
+  int64_t publish_mono_ns; /* when the daemon published the pose */
+  int64_t publish_real_ns;
+  double x_m; /* robot position in `map`, metres (x East, y North) */
+  double y_m;
+  double yaw_rad;       /* (-pi, pi], CCW from East */
+  double covariance[9]; /* (x_m, y_m, yaw_rad) row-major, SI units squared */
+  uint32_t flags;       /* CEILPOSE_POSE_* */
+  uint8_t mode;         /* enum ceilpose_mode */
+  uint8_t reserved0;
+  uint16_t markers; /* decoded markers used */
+} ceilpose_pose;
+
+/* Daemon health, what `ceilposectl status` shows. Filled by the daemon about
+ * once a second. */
+typedef struct ceilpose_status {
+  double fps;              /* processed frames per second, recent */
+  uint64_t frames;         /* frames captured since start */
+  uint64_t drops;          /* frames the capture ring dropped */
+  uint64_t skipped;        /* frames the pipeline skipped to stay current */
+  uint64_t outages;        /* times the source stopped delivering and recovered */
+  uint32_t latency_p50_us; /* capture -> pose published */
+  uint32_t latency_p90_us;
+  uint32_t latency_p99_us;
+  uint32_t latency_max_us;
+  uint32_t fix_state; /* enum ceilpose_fix_state */
+  uint32_t reserved0;
+  int64_t updated_mono_ns;                /* when the daemon filled this record */
+  char source[CEILPOSE_SOURCE_TEXT_SIZE]; /* NUL-terminated, e.g. "v4l2:/dev/video0" */
+} ceilpose_status;
+
+/* Writer state in the segment header. */
+enum ceilpose_writer_state {
+  CEILPOSE_STATE_STARTING = 1, /* segment created, no pose yet */
+  CEILPOSE_STATE_RUNNING = 2,  /* at least one pose published */
+  CEILPOSE_STATE_STOPPED = 3   /* the daemon stopped cleanly */
+};
+
+/* What ceilpose_client_liveness concludes about the writer. */
+enum ceilpose_liveness {
+  CEILPOSE_LIVE = 0,          /* heartbeat fresh, process alive */
+  CEILPOSE_LIVE_STARTING = 1, /* alive, no pose yet */
+  CEILPOSE_STOPPED = 2,       /* the writer marked the segment stopped */
+  CEILPOSE_STALE = 3,         /* process exists but the heartbeat is too old */
+  CEILPOSE_WRITER_DEAD = 4,   /* the writer process is gone (crashed, killed) */
+  CEILPOSE_RESTARTED = 5      /* the name now holds a newer writer: reattach */
+};
+
+typedef struct ceilpose_writer_info {
+  int32_t pid;
+  uint32_t state;      /* enum ceilpose_writer_state */
+  uint64_t generation; /* random per writer start; changes on restart */
+  int64_t start_mono_ns;
+  int64_t start_real_ns;
+  int64_t heartbeat_mono_ns; /* last sign of life, CLOCK_MONOTONIC */
+} ceilpose_writer_info;
+
+/* Return codes: 0 success, negative errors. */
+enum ceilpose_error {
+  CEILPOSE_OK = 0,
+  CEILPOSE_ERR_INVALID_ARGUMENT = -1, /* NULL pointer, bad name */
+  CEILPOSE_ERR_NOT_FOUND = -2,        /* no segment of that name: daemon not running */
+  CEILPOSE_ERR_PERMISSION = -3,       /* not allowed to open the segment (group?) */
+  CEILPOSE_ERR_ABI_MISMATCH = -4,     /* segment of another ABI version */
+  CEILPOSE_ERR_BAD_SIZE = -5,         /* segment size is not what this ABI expects */
+  CEILPOSE_ERR_BAD_MAGIC = -6,        /* not a ceilpose segment */
+  CEILPOSE_ERR_NOT_READY = -7,        /* the writer is still initializing it */
+  CEILPOSE_ERR_SYSTEM = -8,           /* other system error (see message) */
+  CEILPOSE_ERR_NO_MEMORY = -9,
+  CEILPOSE_ERR_NO_POSE = -10,     /* nothing published yet */
+  CEILPOSE_ERR_BUSY = -11,        /* writer kept overwriting the pose during the read */
+  CEILPOSE_ERR_TIMEOUT = -12,     /* no new pose within the timeout */
+  CEILPOSE_ERR_STOPPED = -13,     /* the daemon stopped cleanly */
+  CEILPOSE_ERR_WRITER_DEAD = -14, /* the writer process is gone */
+  CEILPOSE_ERR_LIVE_WRITER = -15, /* (writer side) another daemon owns the name */
+  CEILPOSE_ERR_NO_GROUP = -16     /* (writer side) configured group does not exist */
+};
+
+typedef struct ceilpose_client ceilpose_client;
+
+/* Opens the segment `name` (NULL for "/ceilpose") read-only and checks magic,
+ * ABI version and size. On success stores a new handle in *out. */
+int ceilpose_client_open(const char* name, ceilpose_client** out);
+
+/* Unmaps and frees the handle. NULL is allowed. */
+void ceilpose_client_close(ceilpose_client* client);
+
+/* Copies the latest pose into *out without waiting for the writer. Returns
+ * CEILPOSE_ERR_NO_POSE before the first pose, CEILPOSE_ERR_BUSY if the pose
+ * was overwritten on every retry (the writer never waits for readers). */
+int ceilpose_client_read_latest(ceilpose_client* client, ceilpose_pose* out);
+
+/* Blocks (futex, no polling) until a pose with seq > after_seq exists, then
+ * copies it (the newest) into *out. timeout_ms < 0 waits forever. Returns
+ * CEILPOSE_ERR_TIMEOUT, or CEILPOSE_ERR_STOPPED / CEILPOSE_ERR_WRITER_DEAD
+ * when no pose can come from this writer any more. */
+int ceilpose_client_wait_next(ceilpose_client* client, uint64_t after_seq, int32_t timeout_ms,
+                              ceilpose_pose* out);
+
+/* Judges the writer: stopped, dead (pid gone), stale (heartbeat older than
+ * stale_after_ms), restarted (the name now holds another generation) or live. */
+int ceilpose_client_liveness(ceilpose_client* client, int64_t stale_after_ms,
+                             enum ceilpose_liveness* out);
+
+/* Re-opens the name and, if it holds a valid segment, switches the handle to
+ * it (a restarted daemon). On failure the handle keeps the old segment. */
+int ceilpose_client_reattach(ceilpose_client* client);
+
+/* Copies the daemon's status record into *out. */
+int ceilpose_client_read_status(ceilpose_client* client, ceilpose_status* out);
+
+/* Copies the header's writer identity and heartbeat into *out. */
+int ceilpose_client_writer_info(ceilpose_client* client, ceilpose_writer_info* out);
+
+/* Copies up to max_poses of the most recent poses, newest first, into out and
+ * stores how many in *count. */
+int ceilpose_client_read_recent(ceilpose_client* client, ceilpose_pose* out, uint32_t max_poses,
+                                uint32_t* count);
+
+/* Static English text for a return code. */
+const char* ceilpose_strerror(int code);
+
+/* Detailed message of the last failed call in this thread (names the segment,
+ * its size and mode where relevant); "" if none. */
+const char* ceilpose_last_error_message(void);
+
+/* Layout checks, so C and C++ compilers agree on the shared bytes. */
+#ifdef __cplusplus
+#define CEILPOSE_STATIC_ASSERT(c, m) static_assert(c, m)
+#else
+#define CEILPOSE_STATIC_ASSERT(c, m) _Static_assert(c, m)
+#endif
+CEILPOSE_STATIC_ASSERT(sizeof(ceilpose_pose) == 144, "ceilpose_pose layout");
+CEILPOSE_STATIC_ASSERT(offsetof(ceilpose_pose, x_m) == 40, "ceilpose_pose.x_m offset");
+CEILPOSE_STATIC_ASSERT(offsetof(ceilpose_pose, covariance) == 64, "ceilpose_pose.covariance");
+CEILPOSE_STATIC_ASSERT(offsetof(ceilpose_pose, flags) == 136, "ceilpose_pose.flags offset");
+CEILPOSE_STATIC_ASSERT(offsetof(ceilpose_pose, markers) == 142, "ceilpose_pose.markers offset");
+CEILPOSE_STATIC_ASSERT(sizeof(ceilpose_status) == 168, "ceilpose_status layout");
+CEILPOSE_STATIC_ASSERT(offsetof(ceilpose_status, latency_p50_us) == 40, "status latency offset");
+CEILPOSE_STATIC_ASSERT(offsetof(ceilpose_status, updated_mono_ns) == 64, "status time offset");
+CEILPOSE_STATIC_ASSERT(offsetof(ceilpose_status, source) == 72, "ceilpose_status.source");
+#undef CEILPOSE_STATIC_ASSERT
+
+#ifdef __cplusplus
+}
+#endif
+
+#endif /* CEILPOSE_POSE_CLIENT_H */

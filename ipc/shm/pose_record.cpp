@@ -1,0 +1,53 @@
+#include "ipc/shm/pose_record.h"
+
+#include <cstring>
+
+namespace ceilpose {
+
+const char* to_string(FixState state) {
+  switch (state) {
+    case FixState::kNone:
+      return "none";
+    case FixState::kOk:
+      return "fix";
+    case FixState::kCoasting:
+      return "coasting";
+    case FixState::kLost:
+      return "lost";
+  }
+  return "unknown";
+}
+
+const char* to_string(WriterState state) {
+  switch (state) {
+    case WriterState::kStarting:
+      return "starting";
+    case WriterState::kRunning:
+      return "running";
+    case WriterState::kStopped:
+      return "stopped";
+  }
+  return "unknown";
+}
+
+const char* pose_mode_name(uint8_t mode) {
+  switch (mode) {
+    case CEILPOSE_MODE_AUTO:
+      return "auto";
+    case CEILPOSE_MODE_AXES:
+      return "axes";
+    case CEILPOSE_MODE_BARYCENTRIC:
+      return "barycentric";
+    case CEILPOSE_MODE_LSQ:
+      return "lsq";
+    default:
+      return "unknown";
+  }
+}
+
+void set_status_source(StatusRecord* status, const char* text) {
+  std::strncpy(status->source, text, sizeof(status->source) - 1);
+  status->source[sizeof(status->source) - 1] = '\0';
+}
+
+}  // namespace ceilpose

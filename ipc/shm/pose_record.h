@@ -1,0 +1,44 @@
+#pragma once
+// C++ names for the records of the shared segment. They ARE the C client's
+// structs (ipc/include/ceilpose/pose_client.h), so the daemon, ceilposectl and
+// C controllers read and write the same bytes; that header holds the
+// offsetof/sizeof checks.
+#include <cstdint>
+
+#include "ceilpose/pose_client.h"
+
+namespace ceilpose {
+
+using PoseRecord = ::ceilpose_pose;
+using StatusRecord = ::ceilpose_status;
+
+inline constexpr uint32_t kPoseValid = CEILPOSE_POSE_VALID;
+inline constexpr uint32_t kPoseFiltered = CEILPOSE_POSE_FILTERED;
+inline constexpr uint32_t kPoseCoasting = CEILPOSE_POSE_COASTING;
+
+enum class FixState : uint32_t {
+  kNone = CEILPOSE_FIX_NONE,
+  kOk = CEILPOSE_FIX_OK,
+  kCoasting = CEILPOSE_FIX_COASTING,
+  kLost = CEILPOSE_FIX_LOST,
+};
+
+enum class WriterState : uint32_t {
+  kStarting = CEILPOSE_STATE_STARTING,
+  kRunning = CEILPOSE_STATE_RUNNING,
+  kStopped = CEILPOSE_STATE_STOPPED,
+};
+
+// Names used by ceilposectl (human and JSON output).
+const char* to_string(FixState state);
+const char* to_string(WriterState state);
+// SPEC §5 mode names: auto, axes, barycentric, lsq; "unknown" otherwise.
+const char* pose_mode_name(uint8_t mode);
+
+inline bool pose_is_valid(const PoseRecord& p) { return (p.flags & kPoseValid) != 0; }
+
+// Copies `text` into the status record's fixed source field, truncating and
+// always NUL-terminating.
+void set_status_source(StatusRecord* status, const char* text);
+
+}  // namespace ceilpose

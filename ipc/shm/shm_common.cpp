@@ -1,0 +1,143 @@
+#include "ipc/shm/shm_common.h"
+
+#include <linux/futex.h>
+#include <signal.h>
+#include <sys/mman.h>
+#include <sys/syscall.h>
+#include <unistd.h>
+
+#include <cerrno>
+#include <climits>
+#include <cstdio>
+#include <cstring>
+#include <ctime>
+
+namespace ceilpose::shm {
+
+Error fail(ShmErrc* out, ShmErrc code, std::string message) {
+  if (out != nullptr) *out = code;
+  return make_error(std::move(message));
+}
+
+bool valid_shm_name(const std::string& name) {
+  // NAME_MAX (255) minus room for the "-wake" companion suffix.
+  if (name.size() < 2 || name.size() > 250 || name[0] != '/') return false;
+  return name.find('/', 1) == std::string::npos;
+}
+
+std::string wake_segment_name(const std::string& name) { return name + "-wake"; }
+
+FileDescriptor& FileDescriptor::operator=(FileDescriptor&& other) noexcept {
+  if (this != &other) {
+    reset();
+    fd_ = other.release();
+  }
+  return *this;
+}
+
+int FileDescriptor::release() {
+  const int fd = fd_;
+  fd_ = -1;
+  return fd;
+}
+
+void FileDescriptor::reset() {
+  if (fd_ >= 0) ::close(fd_);
+  fd_ = -1;
+}
+
+Mapping::Mapping(Mapping&& other) noexcept
+    : address_(other.address_), size_bytes_(other.size_bytes_) {
+  other.address_ = nullptr;
+  other.size_bytes_ = 0;
+}
+
+Mapping& Mapping::operator=(Mapping&& other) noexcept {
+  if (this != &other) {
+    reset();
+    address_ = other.address_;
+    size_bytes_ = other.size_bytes_;
+    other.address_ = nullptr;
+    other.size_bytes_ = 0;
+  }
+  return *this;
+}
+
+void Mapping::reset() {
+  if (address_ != nullptr) ::munmap(address_, size_bytes_);
+  address_ = nullptr;
+  size_bytes_ = 0;
+}
+
+Mapping map_shared(int fd, size_t size_bytes, bool writable, int* error) {
+  const int prot = writable ? (PROT_READ | PROT_WRITE) : PROT_READ;
+  void* p = ::mmap(nullptr, size_bytes, prot, MAP_SHARED, fd, 0);
+  if (p == MAP_FAILED) {
+    *error = -errno;
+    return {};
+  }
+  *error = 0;
+  return Mapping(p, size_bytes);
+}
+
+int futex_wait_shared(const void* word, uint32_t expected, int64_t timeout_ns) {
+  timespec ts{};
+  timespec* tsp = nullptr;
+  if (timeout_ns >= 0) {
+    ts.tv_sec = static_cast<time_t>(timeout_ns / 1'000'000'000);
+    ts.tv_nsec = static_cast<long>(timeout_ns % 1'000'000'000);
+    tsp = &ts;
+  }
+  // Not FUTEX_PRIVATE_FLAG: the word is shared between processes, and the
+  // kernel keys it by the backing page, so different mappings meet.
+  const long rc = ::syscall(SYS_futex, word, FUTEX_WAIT, expected, tsp, nullptr, 0);
+  return rc == 0 ? 0 : -errno;
+}
+
+int futex_wake_shared(const void* word) {
+  const long rc = ::syscall(SYS_futex, word, FUTEX_WAKE, INT_MAX, nullptr, nullptr, 0);
+  return rc >= 0 ? static_cast<int>(rc) : -errno;
+}
+
+bool process_exists(int pid) {
+  if (pid <= 0) return false;
+  // EPERM means it exists but belongs to someone else.
+  return ::kill(pid, 0) == 0 || errno != ESRCH;
+}
+
+std::string mode_text(unsigned mode) {
+  const char* kChars = "rwxrwxrwx";
+  std::string text(9, '-');
+  for (int i = 0; i < 9; ++i) {
+    if ((mode & (0400u >> i)) != 0) text[i] = kChars[i];
+  }
+  char octal[8];
+  std::snprintf(octal, sizeof octal, "%04o", mode & 0777u);
+  return std::string(octal) + " (" + text + ")";
+}
+
+std::string errno_text(int error) {
+  if (error < 0) error = -error;
+  const char* name = strerrorname_np(error);
+  return std::string(std::strerror(error)) + " (" + (name != nullptr ? name : "?") + ")";
+}
+
+ShmErrc errc_from_errno(int error) {
+  if (error < 0) error = -error;
+  switch (error) {
+    case ENOENT:
+      return ShmErrc::kNotFound;
+    case EACCES:
+    case EPERM:
+      return ShmErrc::kPermission;
+    case ENOMEM:
+      return ShmErrc::kNoMemory;
+    case EINVAL:
+    case ENAMETOOLONG:
+      return ShmErrc::kInvalidArgument;
+    default:
+      return ShmErrc::kSystem;
+  }
+}
+
+}  // namespace ceilpose::shm

@@ -1,0 +1,94 @@
+#pragma once
+// Pieces shared by the writer and the reader: typed errors, RAII owners of the
+// descriptor and the mapping, the futex calls. Thin system wrappers return
+// -errno and never log; callers turn them into messages with context.
+#include <cstddef>
+#include <cstdint>
+#include <string>
+
+#include "core/result.h"
+
+namespace ceilpose::shm {
+
+// Typed errors; the values are the C client's CEILPOSE_ERR_* codes.
+enum class ShmErrc : int {
+  kOk = 0,
+  kInvalidArgument = -1,
+  kNotFound = -2,
+  kPermission = -3,
+  kAbiMismatch = -4,
+  kBadSize = -5,
+  kBadMagic = -6,
+  kNotReady = -7,
+  kSystem = -8,
+  kNoMemory = -9,
+  kLiveWriter = -15,
+  kNoGroup = -16,
+};
+
+// Stores `code` in *out (if given) and returns the error with `message`.
+Error fail(ShmErrc* out, ShmErrc code, std::string message);
+
+// A POSIX shm name: "/" then 1..250 characters without another "/".
+bool valid_shm_name(const std::string& name);
+std::string wake_segment_name(const std::string& name);
+
+class FileDescriptor {
+ public:
+  FileDescriptor() = default;
+  explicit FileDescriptor(int fd) : fd_(fd) {}
+  ~FileDescriptor() { reset(); }
+  FileDescriptor(FileDescriptor&& other) noexcept : fd_(other.release()) {}
+  FileDescriptor& operator=(FileDescriptor&& other) noexcept;
+  FileDescriptor(const FileDescriptor&) = delete;
+  FileDescriptor& operator=(const FileDescriptor&) = delete;
+
+  int get() const { return fd_; }
+  bool valid() const { return fd_ >= 0; }
+  int release();
+  void reset();
+
+ private:
+  int fd_ = -1;
+};
+
+class Mapping {
+ public:
+  Mapping() = default;
+  Mapping(void* address, size_t size_bytes) : address_(address), size_bytes_(size_bytes) {}
+  ~Mapping() { reset(); }
+  Mapping(Mapping&& other) noexcept;
+  Mapping& operator=(Mapping&& other) noexcept;
+  Mapping(const Mapping&) = delete;
+  Mapping& operator=(const Mapping&) = delete;
+
+  void* get() const { return address_; }
+  size_t size_bytes() const { return size_bytes_; }
+  void reset();
+
+ private:
+  void* address_ = nullptr;
+  size_t size_bytes_ = 0;
+};
+
+// mmap(MAP_SHARED) of `size_bytes` of `fd`; returns -errno in *error on failure.
+Mapping map_shared(int fd, size_t size_bytes, bool writable, int* error);
+
+// FUTEX_WAIT on a shared (inter-process) word while it still equals
+// `expected`, for at most timeout_ns (< 0: forever). Returns 0 when woken,
+// -EAGAIN if the word differed, -ETIMEDOUT, -EINTR.
+int futex_wait_shared(const void* word, uint32_t expected, int64_t timeout_ns);
+// Wakes every waiter on the word; returns how many or -errno.
+int futex_wake_shared(const void* word);
+
+// kill(pid, 0): true unless the process certainly does not exist (ESRCH).
+bool process_exists(int pid);
+
+// "rw-r-----"-style text of the low 9 mode bits, for messages.
+std::string mode_text(unsigned mode);
+// Describes errno values in messages: "Permission denied (EACCES)".
+std::string errno_text(int error);
+// Classifies an errno from shm_open/mmap into a typed error.
+ShmErrc errc_from_errno(int error);
+
+}  // namespace ceilpose::shm

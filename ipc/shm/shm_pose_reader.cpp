@@ -1,0 +1,356 @@
+#include "ipc/shm/shm_pose_reader.h"
+
+#include <fcntl.h>
+#include <sys/mman.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <cerrno>
+#include <limits>
+
+#include "core/clock.h"
+#include "ipc/shm/shm_layout.h"
+
+namespace ceilpose {
+
+using shm::fail;
+using shm::FileDescriptor;
+using shm::Mapping;
+using shm::Segment;
+using shm::ShmErrc;
+using shm::WakeSegment;
+
+namespace {
+
+// A reader blocked in wait_next re-checks that its writer still exists this
+// often, so a crashed daemon is reported even with an infinite timeout.
+constexpr int64_t kLivenessCheckNs = 250'000'000;
+
+// Owner and mode of a segment we may not be allowed to open, for the message.
+std::string describe_access(const std::string& name) {
+  struct stat st {};
+  const std::string path = "/dev/shm" + name;  // where Linux keeps POSIX shm
+  std::string text;
+  if (::stat(path.c_str(), &st) == 0) {
+    text = "segment is mode " + shm::mode_text(st.st_mode) + ", owner uid " +
+           std::to_string(st.st_uid) + " gid " + std::to_string(st.st_gid) + ", " +
+           std::to_string(st.st_size) + " bytes; ";
+  }
+  return text + "this process is uid " + std::to_string(::geteuid()) + " gid " +
+         std::to_string(::getegid()) + " (is it in the segment's group?)";
+}
+
+template <typename T, typename Slot>
+bool load_retrying(const Slot& slot, T* out) {
+  for (int i = 0; i < ShmPoseReader::kReadRetries; ++i) {
+    if (slot.try_load(out)) return true;
+#if defined(__x86_64__) || defined(__i386__)
+    __builtin_ia32_pause();
+#elif defined(__aarch64__)
+    asm volatile("yield");
+#endif
+  }
+  return false;
+}
+
+}  // namespace
+
+const char* to_string(ReadResult r) {
+  switch (r) {
+    case ReadResult::kOk:
+      return "ok";
+    case ReadResult::kNoPose:
+      return "no pose published yet";
+    case ReadResult::kBusy:
+      return "busy (writer overwrote the pose on every retry)";
+  }
+  return "?";
+}
+
+const char* to_string(WaitResult r) {
+  switch (r) {
+    case WaitResult::kPose:
+      return "pose";
+    case WaitResult::kTimeout:
+      return "timeout";
+    case WaitResult::kStopped:
+      return "daemon stopped";
+    case WaitResult::kWriterDead:
+      return "daemon process gone";
+    case WaitResult::kBusy:
+      return "busy";
+  }
+  return "?";
+}
+
+const char* to_string(Liveness l) {
+  switch (l) {
+    case Liveness::kLive:
+      return "live";
+    case Liveness::kStarting:
+      return "starting";
+    case Liveness::kStopped:
+      return "stopped";
+    case Liveness::kStale:
+      return "stale";
+    case Liveness::kWriterDead:
+      return "dead";
+    case Liveness::kRestarted:
+      return "restarted";
+  }
+  return "?";
+}
+
+struct ShmPoseReader::Impl {
+  std::string name;
+  FileDescriptor fd;
+  Mapping mapping;
+  FileDescriptor wake_fd;
+  Mapping wake_mapping;
+  const Segment* seg = nullptr;
+  WakeSegment* wake = nullptr;
+  dev_t dev = 0;
+  ino_t ino = 0;
+
+  const shm::SegmentHeader& header() const { return seg->header; }
+  WriterState state() const {
+    return static_cast<WriterState>(header().state.load(std::memory_order_acquire));
+  }
+  uint64_t latest_seq() const { return header().latest_seq.load(std::memory_order_acquire); }
+};
+
+Result<ShmPoseReader> ShmPoseReader::open(const std::string& name, ShmErrc* code) {
+  if (code != nullptr) *code = ShmErrc::kOk;
+  if (!shm::valid_shm_name(name)) {
+    return fail(code, ShmErrc::kInvalidArgument,
+                "invalid shm segment name '" + name +
+                    "': must be '/' followed by 1-249 characters without '/'");
+  }
+  FileDescriptor fd(::shm_open(name.c_str(), O_RDONLY | O_CLOEXEC, 0));
+  if (!fd.valid()) {
+    const int e = errno;
+    if (e == ENOENT) {
+      return fail(code, ShmErrc::kNotFound,
+                  "no shm segment " + name + " (no ceilposed publishing on it; is it running " +
+                      "with --shm " + name + "?)");
+    }
+    if (e == EACCES) {
+      return fail(code, ShmErrc::kPermission,
+                  "permission denied opening shm segment " + name + ": " + describe_access(name));
+    }
+    return fail(code, shm::errc_from_errno(e),
+                "cannot open shm segment " + name + ": " + shm::errno_text(e));
+  }
+  struct stat st {};
+  if (::fstat(fd.get(), &st) != 0) {
+    const int e = errno;
+    return fail(code, ShmErrc::kSystem,
+                "cannot stat shm segment " + name + ": " + shm::errno_text(e));
+  }
+  const auto size_bytes = static_cast<size_t>(st.st_size);
+  if (size_bytes == 0) {
+    return fail(code, ShmErrc::kNotReady,
+                "shm segment " + name + " is empty: its writer is still creating it");
+  }
+  constexpr size_t kIdentityBytes = offsetof(shm::SegmentHeader, header_size);
+  if (size_bytes < kIdentityBytes) {
+    return fail(code, ShmErrc::kBadSize,
+                "shm segment " + name + " is " + std::to_string(size_bytes) +
+                    " bytes, too small for a ceilpose header (ABI " +
+                    std::to_string(shm::kAbiVersion) + " expects " +
+                    std::to_string(sizeof(Segment)) + " bytes)");
+  }
+  int map_error = 0;
+  Mapping mapping =
+      shm::map_shared(fd.get(), std::min(size_bytes, sizeof(Segment)), false, &map_error);
+  if (mapping.get() == nullptr) {
+    return fail(code, shm::errc_from_errno(map_error),
+                "cannot map shm segment " + name + " (" + std::to_string(size_bytes) +
+                    " bytes): " + shm::errno_text(map_error));
+  }
+  const auto* seg = static_cast<const Segment*>(mapping.get());
+  const uint64_t magic = seg->header.magic.load(std::memory_order_acquire);
+  if (magic == 0) {
+    return fail(code, ShmErrc::kNotReady,
+                "shm segment " + name + " is not initialized yet: its writer is starting");
+  }
+  if (magic != shm::kMagic) {
+    return fail(code, ShmErrc::kBadMagic,
+                "shm segment " + name + " is not a ceilpose pose segment (bad magic)");
+  }
+  const auto& h = seg->header;
+  if (h.abi_version != shm::kAbiVersion) {
+    return fail(code, ShmErrc::kAbiMismatch,
+                "shm segment " + name + " has ABI version " + std::to_string(h.abi_version) +
+                    ", this reader speaks version " + std::to_string(shm::kAbiVersion) +
+                    ": update ceilposectl / the client library to match ceilposed");
+  }
+  if (size_bytes != sizeof(Segment) || h.segment_size != size_bytes ||
+      h.header_size != sizeof(shm::SegmentHeader) || h.ring_length != shm::kRingLength ||
+      h.pose_size != sizeof(PoseRecord) || h.status_size != sizeof(StatusRecord)) {
+    return fail(code, ShmErrc::kBadSize,
+                "shm segment " + name + " is " + std::to_string(size_bytes) +
+                    " bytes (header says " + std::to_string(h.segment_size) + ", ring " +
+                    std::to_string(h.ring_length) + ", pose " + std::to_string(h.pose_size) +
+                    " bytes); ABI " + std::to_string(shm::kAbiVersion) + " expects " +
+                    std::to_string(sizeof(Segment)) + " bytes, ring " +
+                    std::to_string(shm::kRingLength) + ", pose " +
+                    std::to_string(sizeof(PoseRecord)) + " bytes");
+  }
+
+  const std::string wake_name = shm::wake_segment_name(name);
+  FileDescriptor wake_fd(::shm_open(wake_name.c_str(), O_RDWR | O_CLOEXEC, 0));
+  if (!wake_fd.valid()) {
+    const int e = errno;
+    if (e == EACCES) {
+      return fail(code, ShmErrc::kPermission,
+                  "permission denied opening shm segment " + wake_name +
+                      " read-write (needed to wait for poses): " + describe_access(wake_name));
+    }
+    return fail(code, shm::errc_from_errno(e),
+                "cannot open shm segment " + wake_name + " (companion of " + name +
+                    "): " + shm::errno_text(e));
+  }
+  struct stat wst {};
+  if (::fstat(wake_fd.get(), &wst) != 0 ||
+      static_cast<size_t>(wst.st_size) != sizeof(WakeSegment)) {
+    return fail(code, ShmErrc::kNotReady,
+                "shm segment " + wake_name + " is " + std::to_string(wst.st_size) +
+                    " bytes, expected " + std::to_string(sizeof(WakeSegment)) +
+                    " (its writer is starting or replacing it)");
+  }
+  Mapping wake_mapping = shm::map_shared(wake_fd.get(), sizeof(WakeSegment), true, &map_error);
+  if (wake_mapping.get() == nullptr) {
+    return fail(code, shm::errc_from_errno(map_error),
+                "cannot map shm segment " + wake_name + ": " + shm::errno_text(map_error));
+  }
+  auto* wake = static_cast<WakeSegment*>(wake_mapping.get());
+  if (wake->magic.load(std::memory_order_acquire) != shm::kWakeMagic ||
+      wake->generation != h.generation) {
+    return fail(code, ShmErrc::kNotReady,
+                "shm segment " + wake_name + " does not belong to " + name +
+                    " (its writer is starting or replacing it)");
+  }
+
+  auto impl = std::make_unique<Impl>();
+  impl->name = name;
+  impl->fd = std::move(fd);
+  impl->mapping = std::move(mapping);
+  impl->wake_fd = std::move(wake_fd);
+  impl->wake_mapping = std::move(wake_mapping);
+  impl->seg = seg;
+  impl->wake = wake;
+  impl->dev = st.st_dev;
+  impl->ino = st.st_ino;
+  return ShmPoseReader(std::move(impl));
+}
+
+ShmPoseReader::ShmPoseReader(std::unique_ptr<Impl> impl) : impl_(std::move(impl)) {}
+ShmPoseReader::ShmPoseReader(ShmPoseReader&&) noexcept = default;
+ShmPoseReader& ShmPoseReader::operator=(ShmPoseReader&&) noexcept = default;
+ShmPoseReader::~ShmPoseReader() = default;
+
+ReadResult ShmPoseReader::read_latest(PoseRecord* out) const {
+  if (impl_->latest_seq() == 0) return ReadResult::kNoPose;
+  return load_retrying(impl_->seg->latest, out) ? ReadResult::kOk : ReadResult::kBusy;
+}
+
+ReadResult ShmPoseReader::read_status(StatusRecord* out) const {
+  return load_retrying(impl_->seg->status, out) ? ReadResult::kOk : ReadResult::kBusy;
+}
+
+WaitResult ShmPoseReader::wait_next(uint64_t after_seq, int timeout_ms, PoseRecord* out) {
+  Impl& r = *impl_;
+  const auto& h = r.header();
+  const int64_t deadline_ns = timeout_ms < 0 ? std::numeric_limits<int64_t>::max()
+                                             : monotonic_ns() + int64_t{timeout_ms} * 1'000'000;
+  auto take = [&]() {
+    return read_latest(out) == ReadResult::kOk ? WaitResult::kPose : WaitResult::kBusy;
+  };
+  for (;;) {
+    if (r.latest_seq() > after_seq) return take();
+    if (r.state() == WriterState::kStopped) return WaitResult::kStopped;
+    // Register, then sample the futex word, then re-check: the writer stores
+    // the word and then reads `waiters` (both seq_cst), so either it sees us
+    // and wakes, or we see its new word and FUTEX_WAIT returns at once.
+    r.wake->waiters.fetch_add(1, std::memory_order_seq_cst);
+    const uint32_t word = h.wake_seq.load(std::memory_order_seq_cst);
+    int rc = 0;
+    bool timed_out = false;
+    if (r.latest_seq() <= after_seq && r.state() != WriterState::kStopped) {
+      const int64_t remaining_ns = deadline_ns - monotonic_ns();
+      if (remaining_ns <= 0) {
+        timed_out = true;
+      } else {
+        rc = shm::futex_wait_shared(&h.wake_seq, word, std::min(remaining_ns, kLivenessCheckNs));
+      }
+    }
+    r.wake->waiters.fetch_sub(1, std::memory_order_seq_cst);
+    if (r.latest_seq() > after_seq) return take();
+    if (r.state() == WriterState::kStopped) return WaitResult::kStopped;
+    if (timed_out) return WaitResult::kTimeout;
+    if (rc == -ETIMEDOUT || rc == 0) {
+      // Woken without a pose (a replacing writer wakes us) or a slice ended.
+      if (!shm::process_exists(h.writer_pid)) return WaitResult::kWriterDead;
+    }
+  }
+}
+
+Liveness ShmPoseReader::liveness(int64_t stale_after_ms) const {
+  if (replaced()) return Liveness::kRestarted;
+  const auto& h = impl_->header();
+  const WriterState state = impl_->state();
+  if (state == WriterState::kStopped) return Liveness::kStopped;
+  if (!shm::process_exists(h.writer_pid)) return Liveness::kWriterDead;
+  const int64_t age_ns = monotonic_ns() - h.heartbeat_mono_ns.load(std::memory_order_acquire);
+  if (age_ns > stale_after_ms * 1'000'000) return Liveness::kStale;
+  if (state == WriterState::kStarting) return Liveness::kStarting;
+  return Liveness::kLive;
+}
+
+int ShmPoseReader::read_recent(PoseRecord* out, int max_poses) const {
+  const uint64_t newest = impl_->latest_seq();
+  int n = 0;
+  for (uint64_t s = newest; s > 0 && n < max_poses && newest - s < shm::kRingLength; --s) {
+    PoseRecord p;
+    if (!load_retrying(impl_->seg->ring[(s - 1) % shm::kRingLength], &p)) break;
+    if (p.seq != s) break;  // the writer lapped the ring while we read
+    out[n++] = p;
+  }
+  return n;
+}
+
+WriterInfo ShmPoseReader::writer_info() const {
+  const auto& h = impl_->header();
+  WriterInfo info;
+  info.pid = h.writer_pid;
+  info.state = impl_->state();
+  info.generation = h.generation;
+  info.start_mono_ns = h.start_mono_ns;
+  info.start_real_ns = h.start_real_ns;
+  info.heartbeat_mono_ns = h.heartbeat_mono_ns.load(std::memory_order_acquire);
+  return info;
+}
+
+uint64_t ShmPoseReader::latest_seq() const { return impl_->latest_seq(); }
+
+bool ShmPoseReader::replaced() const {
+  FileDescriptor fd(::shm_open(impl_->name.c_str(), O_RDONLY | O_CLOEXEC, 0));
+  if (!fd.valid()) return false;
+  struct stat st {};
+  if (::fstat(fd.get(), &st) != 0) return false;
+  // Our mapping keeps the old inode alive, so its number cannot be reused.
+  return st.st_dev != impl_->dev || st.st_ino != impl_->ino;
+}
+
+Result<void> ShmPoseReader::reattach(ShmErrc* code) {
+  auto fresh = open(impl_->name, code);
+  if (!fresh) return fresh.error();
+  *this = std::move(fresh.value());
+  return {};
+}
+
+const std::string& ShmPoseReader::name() const { return impl_->name; }
+
+}  // namespace ceilpose

@@ -1,0 +1,383 @@
+#include "ipc/shm/shm_pose_writer.h"
+
+#include <fcntl.h>
+#include <grp.h>
+#include <sys/file.h>
+#include <sys/mman.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include <cerrno>
+#include <condition_variable>
+#include <mutex>
+#include <new>
+#include <thread>
+#include <vector>
+
+#include "core/clock.h"
+#include "ipc/shm/shm_layout.h"
+
+namespace ceilpose {
+
+using shm::fail;
+using shm::FileDescriptor;
+using shm::Mapping;
+using shm::Segment;
+using shm::ShmErrc;
+using shm::WakeSegment;
+
+namespace {
+
+constexpr mode_t kSegmentMode = 0640;
+// Readers must write the waiter count, so the companion is group-writable.
+constexpr mode_t kWakeMode = 0660;
+// Creation races with another creator at most a couple of times.
+constexpr int kCreateAttempts = 3;
+
+Result<gid_t> lookup_group(const std::string& group, const std::string& segment, ShmErrc* code) {
+  if (group.empty()) return ::getegid();
+  std::vector<char> buffer(16384);
+  struct group entry {};
+  struct group* found = nullptr;
+  int rc = 0;
+  while ((rc = ::getgrnam_r(group.c_str(), &entry, buffer.data(), buffer.size(), &found)) ==
+             ERANGE &&
+         buffer.size() < (1u << 20)) {
+    buffer.resize(buffer.size() * 4);
+  }
+  if (rc != 0) {
+    return fail(code, ShmErrc::kSystem,
+                "cannot look up group '" + group + "' for shm segment " + segment + ": " +
+                    shm::errno_text(rc));
+  }
+  if (found == nullptr) {
+    return fail(code, ShmErrc::kNoGroup,
+                "group '" + group + "' for shm segment " + segment + " does not exist");
+  }
+  return found->gr_gid;
+}
+
+// Reads the writer pid of an existing segment for the "live writer" message;
+// 0 when the segment is not (yet) a valid one.
+int existing_writer_pid(int fd) {
+  struct stat st {};
+  if (::fstat(fd, &st) != 0 || static_cast<size_t>(st.st_size) != sizeof(Segment)) return 0;
+  int error = 0;
+  Mapping m = shm::map_shared(fd, sizeof(Segment), false, &error);
+  if (m.get() == nullptr) return 0;
+  const auto* seg = static_cast<const Segment*>(m.get());
+  if (seg->header.magic.load(std::memory_order_acquire) != shm::kMagic) return 0;
+  return seg->header.writer_pid;
+}
+
+// Blocked readers of a segment about to be replaced re-check their writer.
+void wake_readers_of(int fd) {
+  struct stat st {};
+  if (::fstat(fd, &st) != 0 || static_cast<size_t>(st.st_size) != sizeof(Segment)) return;
+  int error = 0;
+  Mapping m = shm::map_shared(fd, sizeof(Segment), false, &error);
+  if (m.get() == nullptr) return;
+  shm::futex_wake_shared(&static_cast<const Segment*>(m.get())->header.wake_seq);
+}
+
+uint64_t new_generation() {
+  // Unique per start: two writers never share both a pid and a nanosecond.
+  const uint64_t g = static_cast<uint64_t>(realtime_ns()) ^
+                     (static_cast<uint64_t>(::getpid()) << 40) ^
+                     static_cast<uint64_t>(monotonic_ns());
+  return g == 0 ? 1 : g;
+}
+
+Result<void> set_owner_and_mode(int fd, const std::string& name, mode_t mode, gid_t gid,
+                                ShmErrc* code) {
+  // fchmod, not the shm_open mode: the process umask must not narrow it.
+  if (::fchmod(fd, mode) != 0) {
+    const int e = errno;
+    return fail(code, shm::errc_from_errno(e),
+                "cannot set mode " + shm::mode_text(mode) + " on shm segment " + name + ": " +
+                    shm::errno_text(e));
+  }
+  if (::fchown(fd, static_cast<uid_t>(-1), gid) != 0) {
+    const int e = errno;
+    return fail(code, shm::errc_from_errno(e),
+                "cannot give shm segment " + name + " to group id " + std::to_string(gid) + ": " +
+                    shm::errno_text(e));
+  }
+  return {};
+}
+
+}  // namespace
+
+struct ShmPoseWriter::Impl {
+  std::string name;
+  FileDescriptor fd;  // holds the flock that marks a live writer
+  Mapping mapping;
+  FileDescriptor wake_fd;
+  Mapping wake_mapping;
+  Segment* seg = nullptr;
+  WakeSegment* wake = nullptr;
+  uint64_t seq = 0;
+  uint32_t wake_seq = 0;
+  bool running = false;
+  bool stopped = false;
+
+  std::mutex heartbeat_mutex;
+  std::condition_variable heartbeat_cv;
+  bool heartbeat_stop = false;
+  std::thread heartbeat_thread;
+
+  ~Impl() {
+    stop_heartbeat_thread();
+    if (seg != nullptr && !stopped) mark_stopped();
+  }
+
+  void beat() { seg->header.heartbeat_mono_ns.store(monotonic_ns(), std::memory_order_release); }
+
+  void wake_readers(bool always) {
+    wake_seq += 1;
+    // seq_cst store and seq_cst load of `waiters`, against the reader's
+    // seq_cst increment of `waiters` and load of wake_seq: one side always
+    // sees the other, so a reader never sleeps through a publish.
+    seg->header.wake_seq.store(wake_seq, std::memory_order_seq_cst);
+    if (always || wake->waiters.load(std::memory_order_seq_cst) != 0) {
+      shm::futex_wake_shared(&seg->header.wake_seq);
+    }
+  }
+
+  void mark_stopped() {
+    seg->header.state.store(static_cast<uint32_t>(WriterState::kStopped),
+                            std::memory_order_release);
+    beat();
+    stopped = true;
+    wake_readers(true);
+  }
+
+  void start_heartbeat_thread(int period_ms) {
+    heartbeat_thread = std::thread([this, period_ms] {
+      std::unique_lock<std::mutex> lock(heartbeat_mutex);
+      while (!heartbeat_cv.wait_for(lock, std::chrono::milliseconds(period_ms),
+                                    [this] { return heartbeat_stop; })) {
+        beat();
+      }
+    });
+  }
+
+  void stop_heartbeat_thread() {
+    if (!heartbeat_thread.joinable()) return;
+    {
+      std::lock_guard<std::mutex> lock(heartbeat_mutex);
+      heartbeat_stop = true;
+    }
+    heartbeat_cv.notify_all();
+    heartbeat_thread.join();
+  }
+};
+
+Result<ShmPoseWriter> ShmPoseWriter::create(const ShmOptions& options, ShmErrc* code) {
+  if (code != nullptr) *code = ShmErrc::kOk;
+  const std::string& name = options.name;
+  if (!shm::valid_shm_name(name)) {
+    return fail(code, ShmErrc::kInvalidArgument,
+                "invalid shm segment name '" + name +
+                    "': must be '/' followed by 1-249 characters without '/'");
+  }
+  if (options.heartbeat_period_ms < 0) {
+    return fail(code, ShmErrc::kInvalidArgument,
+                "heartbeat period for shm segment " + name + " must be >= 0 ms, got " +
+                    std::to_string(options.heartbeat_period_ms));
+  }
+  auto gid = lookup_group(options.group, name, code);
+  if (!gid) return gid.error();
+
+  // 1. Create the name exclusively; an existing segment is replaced only when
+  //    no live writer holds its lock (flock is dropped by the kernel when the
+  //    owner dies, whatever the pid namespace).
+  FileDescriptor fd;
+  for (int attempt = 0; attempt < kCreateAttempts && !fd.valid(); ++attempt) {
+    fd = FileDescriptor(
+        ::shm_open(name.c_str(), O_RDWR | O_CREAT | O_EXCL | O_CLOEXEC, kSegmentMode));
+    if (fd.valid()) break;
+    const int e = errno;
+    if (e != EEXIST) {
+      return fail(code, shm::errc_from_errno(e),
+                  "cannot create shm segment " + name + " (mode " + shm::mode_text(kSegmentMode) +
+                      "): " + shm::errno_text(e));
+    }
+    FileDescriptor old(::shm_open(name.c_str(), O_RDWR | O_CLOEXEC, 0));
+    if (!old.valid()) {
+      const int oe = errno;
+      if (oe == ENOENT) continue;  // removed meanwhile: try again
+      return fail(code, shm::errc_from_errno(oe),
+                  "shm segment " + name +
+                      " exists and cannot be opened to check its writer: " + shm::errno_text(oe));
+    }
+    if (::flock(old.get(), LOCK_EX | LOCK_NB) != 0) {
+      const int le = errno;
+      if (le == EWOULDBLOCK) {
+        const int pid = existing_writer_pid(old.get());
+        return fail(code, ShmErrc::kLiveWriter,
+                    "another ceilposed (pid " + (pid > 0 ? std::to_string(pid) : "unknown") +
+                        ") is publishing on " + name);
+      }
+      return fail(code, ShmErrc::kSystem,
+                  "cannot lock shm segment " + name + ": " + shm::errno_text(le));
+    }
+    // Its writer is gone: replace it. Unlink while holding its lock so a
+    // concurrent creator sees it as owned.
+    wake_readers_of(old.get());
+    if (::shm_unlink(name.c_str()) != 0 && errno != ENOENT) {
+      const int ue = errno;
+      return fail(code, shm::errc_from_errno(ue),
+                  "cannot remove stale shm segment " + name + ": " + shm::errno_text(ue));
+    }
+  }
+  if (!fd.valid()) {
+    return fail(code, ShmErrc::kLiveWriter,
+                "shm segment " + name + " keeps being re-created by another process");
+  }
+  // Between O_EXCL and this lock another creator could only see an empty,
+  // unlocked segment; it would replace it and our lock still wins on ours.
+  if (::flock(fd.get(), LOCK_EX | LOCK_NB) != 0) {
+    const int le = errno;
+    return fail(code, ShmErrc::kLiveWriter,
+                "cannot lock new shm segment " + name + ": " + shm::errno_text(le));
+  }
+
+  auto impl = std::make_unique<Impl>();
+  impl->name = name;
+  // Until the segment is complete, any failure removes what was made.
+  struct Cleanup {
+    const std::string* name;
+    bool armed = true;
+    ~Cleanup() {
+      if (!armed) return;
+      ::shm_unlink(name->c_str());
+      ::shm_unlink(shm::wake_segment_name(*name).c_str());
+    }
+  } cleanup{&name};
+
+  if (auto r = set_owner_and_mode(fd.get(), name, kSegmentMode, *gid, code); !r) return r.error();
+
+  // 2. The companion "-wake" segment, complete before the main one is.
+  const std::string wake_name = shm::wake_segment_name(name);
+  ::shm_unlink(wake_name.c_str());  // a stale one, if any; ENOENT is normal
+  FileDescriptor wake_fd(
+      ::shm_open(wake_name.c_str(), O_RDWR | O_CREAT | O_EXCL | O_CLOEXEC, kWakeMode));
+  if (!wake_fd.valid()) {
+    const int e = errno;
+    return fail(code, shm::errc_from_errno(e),
+                "cannot create shm segment " + wake_name + " (mode " + shm::mode_text(kWakeMode) +
+                    "): " + shm::errno_text(e));
+  }
+  if (auto r = set_owner_and_mode(wake_fd.get(), wake_name, kWakeMode, *gid, code); !r) {
+    return r.error();
+  }
+  if (::ftruncate(wake_fd.get(), sizeof(WakeSegment)) != 0) {
+    const int e = errno;
+    return fail(code, shm::errc_from_errno(e),
+                "cannot size shm segment " + wake_name + " to " +
+                    std::to_string(sizeof(WakeSegment)) + " bytes: " + shm::errno_text(e));
+  }
+  int map_error = 0;
+  Mapping wake_mapping = shm::map_shared(wake_fd.get(), sizeof(WakeSegment), true, &map_error);
+  if (wake_mapping.get() == nullptr) {
+    return fail(code, shm::errc_from_errno(map_error),
+                "cannot map shm segment " + wake_name + ": " + shm::errno_text(map_error));
+  }
+  const uint64_t generation = new_generation();
+  auto* wake = new (wake_mapping.get()) WakeSegment();
+  wake->generation = generation;
+  wake->magic.store(shm::kWakeMagic, std::memory_order_release);
+
+  // 3. The pose segment; `magic` last, so a reader that sees it sees the rest.
+  if (::ftruncate(fd.get(), sizeof(Segment)) != 0) {
+    const int e = errno;
+    return fail(code, shm::errc_from_errno(e),
+                "cannot size shm segment " + name + " to " + std::to_string(sizeof(Segment)) +
+                    " bytes: " + shm::errno_text(e));
+  }
+  Mapping mapping = shm::map_shared(fd.get(), sizeof(Segment), true, &map_error);
+  if (mapping.get() == nullptr) {
+    return fail(code, shm::errc_from_errno(map_error),
+                "cannot map shm segment " + name + " (" + std::to_string(sizeof(Segment)) +
+                    " bytes): " + shm::errno_text(map_error));
+  }
+  auto* seg = new (mapping.get()) Segment();
+  auto& h = seg->header;
+  h.abi_version = shm::kAbiVersion;
+  h.header_size = sizeof(shm::SegmentHeader);
+  h.segment_size = sizeof(Segment);
+  h.ring_length = shm::kRingLength;
+  h.pose_size = sizeof(PoseRecord);
+  h.status_size = sizeof(StatusRecord);
+  h.writer_pid = ::getpid();
+  h.generation = generation;
+  h.start_mono_ns = monotonic_ns();
+  h.start_real_ns = realtime_ns();
+  h.state.store(static_cast<uint32_t>(WriterState::kStarting), std::memory_order_relaxed);
+  h.heartbeat_mono_ns.store(h.start_mono_ns, std::memory_order_relaxed);
+  h.magic.store(shm::kMagic, std::memory_order_release);
+
+  impl->fd = std::move(fd);
+  impl->mapping = std::move(mapping);
+  impl->wake_fd = std::move(wake_fd);
+  impl->wake_mapping = std::move(wake_mapping);
+  impl->seg = seg;
+  impl->wake = wake;
+  if (options.heartbeat_period_ms > 0) impl->start_heartbeat_thread(options.heartbeat_period_ms);
+  cleanup.armed = false;
+  return ShmPoseWriter(std::move(impl));
+}
+
+Result<void> ShmPoseWriter::remove(const std::string& name) {
+  if (!shm::valid_shm_name(name)) {
+    return make_error("invalid shm segment name '" + name + "'");
+  }
+  for (const std::string& n : {name, shm::wake_segment_name(name)}) {
+    if (::shm_unlink(n.c_str()) != 0 && errno != ENOENT) {
+      const int e = errno;
+      return make_error("cannot remove shm segment " + n + ": " + shm::errno_text(e));
+    }
+  }
+  return {};
+}
+
+ShmPoseWriter::ShmPoseWriter(std::unique_ptr<Impl> impl) : impl_(std::move(impl)) {}
+ShmPoseWriter::ShmPoseWriter(ShmPoseWriter&&) noexcept = default;
+ShmPoseWriter& ShmPoseWriter::operator=(ShmPoseWriter&&) noexcept = default;
+ShmPoseWriter::~ShmPoseWriter() = default;
+
+void ShmPoseWriter::publish(const PoseRecord& pose) {
+  Impl& w = *impl_;
+  PoseRecord p = pose;
+  p.seq = ++w.seq;
+  if (p.publish_mono_ns == 0) p.publish_mono_ns = monotonic_ns();
+  if (p.publish_real_ns == 0) p.publish_real_ns = realtime_ns();
+  auto& h = w.seg->header;
+  w.seg->latest.store(p);
+  w.seg->ring[(p.seq - 1) % shm::kRingLength].store(p);
+  h.latest_seq.store(p.seq, std::memory_order_release);
+  if (!w.running) {
+    h.state.store(static_cast<uint32_t>(WriterState::kRunning), std::memory_order_release);
+    w.running = true;
+  }
+  h.heartbeat_mono_ns.store(p.publish_mono_ns, std::memory_order_release);
+  w.wake_readers(false);
+}
+
+void ShmPoseWriter::update_status(const StatusRecord& status) {
+  StatusRecord s = status;
+  if (s.updated_mono_ns == 0) s.updated_mono_ns = monotonic_ns();
+  s.source[sizeof(s.source) - 1] = '\0';
+  impl_->seg->status.store(s);
+}
+
+void ShmPoseWriter::heartbeat() { impl_->beat(); }
+
+void ShmPoseWriter::mark_stopped() { impl_->mark_stopped(); }
+
+const std::string& ShmPoseWriter::name() const { return impl_->name; }
+uint64_t ShmPoseWriter::generation() const { return impl_->seg->header.generation; }
+uint64_t ShmPoseWriter::last_seq() const { return impl_->seq; }
+
+}  // namespace ceilpose
