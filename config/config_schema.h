@@ -1,0 +1,228 @@
+#pragma once
+// The one list of configuration keys. Reading (config_loader.cpp) and writing
+// (config_writer.cpp) both walk it, so a key cannot be readable but not
+// printable, or documented under a different name. Internal to config/.
+#include <array>
+#include <cmath>
+#include <cstring>
+#include <numbers>
+#include <string>
+#include <utility>
+
+#include "config/service_config.h"
+#include "pipeline/marker_observation.h"
+
+namespace ceilpose::config_detail {
+
+template <typename T>
+using Choices = std::initializer_list<std::pair<const char*, T>>;
+
+// Returns nullptr when `value` is acceptable, else what was expected.
+using TextCheck = const char* (*)(const std::string& value);
+
+inline const char* check_source(const std::string& s) {
+  constexpr const char* kExpected =
+      "a source: synthetic | replay:DIR | v4l2:/dev/videoN | libcamera[:ID]";
+  if (s == "synthetic" || s == "libcamera") return nullptr;
+  if (s.rfind("replay:", 0) == 0 && s.size() > 7) return nullptr;
+  if (s.rfind("v4l2:/dev/", 0) == 0 && s.size() > 10) return nullptr;
+  if (s.rfind("libcamera:", 0) == 0 && s.size() > 10) return nullptr;
+  return kExpected;
+}
+
+inline const char* check_shm_name(const std::string& s) {
+  // POSIX: one leading slash, no other, at most NAME_MAX characters.
+  if (s.size() >= 2 && s.size() <= 255 && s[0] == '/' && s.find('/', 1) == std::string::npos)
+    return nullptr;
+  return "a shared-memory name: '/' followed by 1-254 characters without '/'";
+}
+
+inline const char* check_any_text(const std::string&) { return nullptr; }
+
+inline const char* check_no_space(const std::string& s) {
+  if (s.find_first_of(" \t\n/") == std::string::npos) return nullptr;
+  return "a name without spaces or '/'";
+}
+
+inline constexpr double kPi = std::numbers::pi;
+
+// Visitor V provides:
+//   section(name, fn)             a nested mapping
+//   field(name, int&/float&/double&/uint64_t&, min, max)
+//   field(name, bool&)
+//   text(name, std::string&, TextCheck)
+//   texts(name, std::vector<std::string>&, TextCheck)
+//   choice(name, T&, Choices<T>)
+//   numbers(name, std::array<double, N>&)
+//   colour(name, Rgb&)
+template <typename V>
+void describe(V& v, ServiceConfig& c) {
+  PipelineConfig& p = c.pipeline;
+  v.section("camera", [&] {
+    CameraIntrinsics& k = p.intrinsics;
+    v.field("width", k.width, 1, 16384);
+    v.field("height", k.height, 1, 16384);
+    v.field("fx", k.fx, 1.0, 1e6);
+    v.field("fy", k.fy, 1.0, 1e6);
+    v.field("cx", k.cx, -1e5, 1e5);
+    v.field("cy", k.cy, -1e5, 1e5);
+    v.numbers("distortion", k.distortion);
+  });
+  v.section("mount", [&] {
+    CameraMount& m = p.mount;
+    v.field("lens_height_m", m.lens_height_m, 0.0, 10.0);
+    v.field("offset_forward_m", m.offset_forward_m, -10.0, 10.0);
+    v.field("offset_left_m", m.offset_left_m, -10.0, 10.0);
+    v.field("yaw_rad", m.yaw_rad, -kPi, kPi);
+    v.field("tilt_x_rad", m.tilt_x_rad, -0.35, 0.35);
+    v.field("tilt_y_rad", m.tilt_y_rad, -0.35, 0.35);
+  });
+  v.section("ceiling", [&] {
+    CeilingLayout& l = p.layout;
+    v.field("height_m", l.height_m, 0.1, 100.0);
+    v.field("grid_m", l.grid_m, 0.01, 100.0);
+    v.field("bits", l.bits, 1, kMaxBits);
+    v.field("rect_width_m", l.rect_width_m, 0.001, 10.0);
+    v.field("rect_height_m", l.rect_height_m, 0.001, 10.0);
+    v.field("slot_pitch_m", l.slot_pitch_m, 0.001, 10.0);
+    v.field("green_dot_e_m", l.green_dot_e_m, 0.001, 10.0);
+    v.field("green_dot_n_m", l.green_dot_n_m, 0.001, 10.0);
+    v.field("red_dot_e_m", l.red_dot_e_m, 0.001, 10.0);
+    v.field("red_dot_n_m", l.red_dot_n_m, 0.001, 10.0);
+    v.field("rail_width_m", l.rail_width_m, 0.0, 1.0);
+    v.colour("red", l.red);
+    v.colour("green", l.green);
+    v.colour("dot", l.dot);
+    v.colour("tile", l.tile);
+    v.colour("rail", l.rail);
+  });
+  v.section("detector", [&] {
+    DetectorParams& d = p.detector;
+    v.field("dark_max_value", d.dark_max_value, 0, 255);
+    v.field("red_min_saturation", d.red_min_saturation, 0.0f, 1.0f);
+    v.field("green_min_saturation", d.green_min_saturation, 0.0f, 1.0f);
+    v.field("red_green_split", d.red_green_split, -255, 255);
+    v.field("red_hue_min_deg", d.red_hue_min_deg, -180.0f, 360.0f);
+    v.field("red_hue_max_deg", d.red_hue_max_deg, -180.0f, 360.0f);
+    v.field("green_hue_min_deg", d.green_hue_min_deg, -180.0f, 360.0f);
+    v.field("green_hue_max_deg", d.green_hue_max_deg, -180.0f, 360.0f);
+    v.field("white_sample_step_px", d.white_sample_step_px, 1, 256);
+    v.field("white_min_share", d.white_min_share, 0.0f, 1.0f);
+    v.field("max_runs_per_pixel", d.max_runs_per_pixel, 0.001f, 1.0f);
+    v.field("min_rect_area_px", d.min_rect_area_px, 1, 1 << 24);
+    v.field("area_min_ratio", d.area_min_ratio, 0.0f, 100.0f);
+    v.field("area_max_ratio", d.area_max_ratio, 0.0f, 100.0f);
+    v.field("aspect_min", d.aspect_min, 0.0f, 1.0f);
+    v.field("aspect_max", d.aspect_max, 0.0f, 1.0f);
+    v.field("fill_min", d.fill_min, 0.0f, 2.0f);
+    v.field("fill_max", d.fill_max, 0.0f, 2.0f);
+    v.field("pair_distance_tolerance", d.pair_distance_tolerance, 0.0f, 10.0f);
+    v.field("pair_area_tolerance", d.pair_area_tolerance, 0.0f, 10.0f);
+    v.field("pair_angle_tolerance_rad", d.pair_angle_tolerance_rad, 0.0f, 3.15f);
+    v.field("dot_threshold_ratio", d.dot_threshold_ratio, 0.0f, 1.0f);
+  });
+  v.section("positioning", [&] {
+    v.choice("mode", c.positioning_mode,
+             Choices<PositioningMode>{{"auto", PositioningMode::kAuto},
+                                      {"axes", PositioningMode::kChangeOfAxes},
+                                      {"barycentric", PositioningMode::kBarycentric},
+                                      {"lsq", PositioningMode::kLeastSquares}});
+    PositioningParams& q = p.positioning;
+    v.field("lsq_max_iterations", q.lsq_max_iterations, 1, 1000);
+    v.field("lsq_step_tolerance", q.lsq_step_tolerance, 0.0, 1.0);
+    v.field("lsq_huber_px", q.lsq_huber_px, 0.01, 1000.0);
+    v.field("lsq_marker_reject_px", q.lsq_marker_reject_px, 0.01, 1000.0);
+    v.field("lsq_max_rms_px", q.lsq_max_rms_px, 0.01, 1000.0);
+    v.field("lsq_min_points", q.lsq_min_points, 3, 10000);
+    v.field("lsq_estimate_tilt", q.lsq_estimate_tilt);
+    v.field("lsq_tilt_select_chi2", q.lsq_tilt_select_chi2, 0.0, 1e6);
+    v.field("lsq_tilt_prior_rad", q.lsq_tilt_prior_rad, 1e-6, 1.0);
+    v.field("lsq_tilt_min_markers", q.lsq_tilt_min_markers, 1, kMaxMarkersPerFrame);
+    v.field("lsq_estimate_height", q.lsq_estimate_height);
+    v.field("grid_tolerance_units", q.grid_tolerance_units, 0.01, 0.5);
+    v.field("heading_tolerance_rad", q.heading_tolerance_rad, 0.0, kPi);
+    v.field("barycentric_min_area_units2", q.barycentric_min_area_units2, 0.0, 100.0);
+    v.field("thesis_sigma_m", q.thesis_sigma_m, 1e-6, 10.0);
+    v.field("thesis_sigma_yaw_rad", q.thesis_sigma_yaw_rad, 1e-6, kPi);
+    v.field("lsq_sigma_floor_m", q.lsq_sigma_floor_m, 0.0, 10.0);
+    v.field("lsq_sigma_floor_yaw_rad", q.lsq_sigma_floor_yaw_rad, 0.0, kPi);
+  });
+  v.section("filter", [&] {
+    FilterParams& f = p.filter;
+    v.field("enabled", f.enabled);
+    v.field("accel_sigma_mps2", f.accel_sigma_mps2, 1e-6, 1000.0);
+    v.field("yaw_accel_sigma_radps2", f.yaw_accel_sigma_radps2, 1e-6, 1000.0);
+    v.field("meas_sigma_floor_m", f.meas_sigma_floor_m, 0.0, 10.0);
+    v.field("meas_sigma_floor_yaw_rad", f.meas_sigma_floor_yaw_rad, 0.0, kPi);
+    v.field("gate_chi2", f.gate_chi2, 0.1, 1e6);
+    v.field("gate_min_m", f.gate_min_m, 0.0, 100.0);
+    v.field("gate_min_rad", f.gate_min_rad, 0.0, kPi);
+    v.field("reinit_after_gated", f.reinit_after_gated, 1, 100000);
+    v.field("predict_timeout_ms", f.predict_timeout_ms, 0.0, 60000.0);
+    v.field("init_velocity_sigma_mps", f.init_velocity_sigma_mps, 1e-6, 100.0);
+    v.field("init_yaw_rate_sigma_radps", f.init_yaw_rate_sigma_radps, 1e-6, 100.0);
+  });
+  v.section("capture", [&] {
+    CaptureConfig& k = c.capture;
+    v.text("source", k.source, &check_source);
+    v.field("width_px", k.width_px, 1, 16384);
+    v.field("height_px", k.height_px, 1, 16384);
+    v.field("fps", k.fps, 0.1, 1000.0);
+    v.choice("pixel_format", k.pixel_format,
+             Choices<std::string>{{"auto", "auto"},
+                                  {"yuyv", "yuyv"},
+                                  {"mjpeg", "mjpeg"},
+                                  {"rgb24", "rgb24"},
+                                  {"bgr24", "bgr24"},
+                                  {"gray8", "gray8"}});
+    v.field("buffer_count", k.buffer_count, 2, 32);
+    v.field("rt_priority", k.rt_priority, 0, 99);
+    v.field("cpu", k.cpu, -1, 1023);
+    v.field("lock_exposure", k.lock_exposure);
+    v.field("exposure_us", k.exposure_us, 1, 10'000'000);
+    v.field("lock_gain", k.lock_gain);
+    v.field("gain", k.gain, -1, 1'000'000);
+    v.field("lock_white_balance", k.lock_white_balance);
+    v.field("white_balance_k", k.white_balance_k, 1000, 20000);
+    v.field("stall_timeout_ms", k.stall_timeout_ms, 10, 600'000);
+    v.field("reconnect_initial_ms", k.reconnect_initial_ms, 1, 600'000);
+    v.field("reconnect_max_ms", k.reconnect_max_ms, 1, 600'000);
+    v.field("replay_speed", k.replay_speed, 0.0, 1000.0);
+    v.field("replay_loop", k.replay_loop);
+    v.field("synthetic_seed", k.synthetic_seed, uint64_t{0}, UINT64_MAX);
+  });
+  v.section("ipc", [&] {
+    v.text("shm_name", c.ipc.shm_name, &check_shm_name);
+    v.text("group", c.ipc.group, &check_any_text);
+    v.field("stale_after_ms", c.ipc.stale_after_ms, 1, 600'000);
+  });
+  v.section("dds", [&] {
+    DdsConfig& d = c.dds;
+    v.field("enabled", d.enabled);
+    // RTPS port arithmetic leaves room for domains 0..230 only (Cyclone's limit).
+    v.field("domain_id", d.domain_id, 0, 230);
+    v.text("robot_name", d.robot_name, &check_no_space);
+    v.choice("reliability", d.reliable, Choices<bool>{{"reliable", true}, {"best_effort", false}});
+    v.field("history_depth", d.history_depth, 1, 1000);
+    v.texts("interfaces", d.interfaces, &check_no_space);
+    v.texts("peers", d.peers, &check_no_space);
+    v.field("status_period_ms", d.status_period_ms, 10, 60'000);
+  });
+  v.section("logging", [&] {
+    v.choice("level", c.logging.level,
+             Choices<LogLevel>{{"trace", LogLevel::kTrace},
+                               {"debug", LogLevel::kDebug},
+                               {"info", LogLevel::kInfo},
+                               {"warn", LogLevel::kWarn},
+                               {"error", LogLevel::kError},
+                               {"critical", LogLevel::kCritical},
+                               {"off", LogLevel::kOff}});
+    v.field("problem_report_interval_ms", c.logging.problem_report_interval_ms, 100, 3'600'000);
+  });
+  v.section("watchdog", [&] {
+    v.field("max_stall_ms", c.watchdog.max_stall_ms, 10, 600'000);
+    v.field("status_interval_ms", c.watchdog.status_interval_ms, 50, 60'000);
+  });
+}
+
+}  // namespace ceilpose::config_detail

@@ -1,0 +1,146 @@
+// Writes a configuration back as YAML by walking the same schema the loader
+// reads, so `ceilposed --print-config` output loads back unchanged.
+#include <charconv>
+#include <sstream>
+
+#include "config/config_schema.h"
+
+namespace ceilpose {
+namespace {
+
+using config_detail::Choices;
+using config_detail::TextCheck;
+
+std::string quoted(const std::string& s) {
+  std::string out = "\"";
+  for (char ch : s) {
+    if (ch == '"' || ch == '\\') out += '\\';
+    out += ch;
+  }
+  return out + "\"";
+}
+
+// Shortest text that reads back as the same double, always with a '.' or an
+// exponent so that YAML readers see a float.
+template <typename T>
+std::string double_text(T v) {
+  char buf[64];
+  auto [end, ec] = std::to_chars(buf, buf + sizeof(buf), v);
+  std::string s(buf, ec == std::errc() ? end : buf);
+  if (s.find_first_of(".eEn") == std::string::npos) s += ".0";
+  return s;
+}
+
+class Writer {
+ public:
+  explicit Writer(std::ostringstream* out) : out_(out) {}
+
+  template <typename Fn>
+  void section(const char* name, Fn fn) {
+    line(name, "");
+    indent_ += 2;
+    fn();
+    indent_ -= 2;
+  }
+  void field(const char* name, int& v, int, int) { line(name, std::to_string(v)); }
+  void field(const char* name, uint64_t& v, uint64_t, uint64_t) { line(name, std::to_string(v)); }
+  void field(const char* name, double& v, double, double) { line(name, double_text(v)); }
+  void field(const char* name, float& v, float, float) { line(name, double_text(v)); }
+  void field(const char* name, bool& v) { line(name, v ? "true" : "false"); }
+  void text(const char* name, std::string& v, TextCheck) { line(name, quoted(v)); }
+  void texts(const char* name, std::vector<std::string>& v, TextCheck) {
+    std::string s = "[";
+    for (size_t i = 0; i < v.size(); ++i) {
+      if (i > 0) s += ", ";
+      s += quoted(v[i]);
+    }
+    line(name, s + "]");
+  }
+  template <typename T>
+  void choice(const char* name, T& v, Choices<T> choices) {
+    for (const auto& [text, value] : choices)
+      if (value == v) return line(name, text);
+  }
+  template <size_t N>
+  void numbers(const char* name, std::array<double, N>& v) {
+    std::string s = "[";
+    for (size_t i = 0; i < N; ++i) {
+      if (i > 0) s += ", ";
+      s += double_text(v[i]);
+    }
+    line(name, s + "]");
+  }
+  void colour(const char* name, Rgb& v) {
+    std::string s = "[";
+    s.append(std::to_string(v.r)).append(", ").append(std::to_string(v.g)).append(", ");
+    s.append(std::to_string(v.b)).append("]");
+    line(name, s);
+  }
+
+ private:
+  void line(const char* name, const std::string& value) {
+    *out_ << std::string(indent_, ' ') << name << ":" << (value.empty() ? "" : " ") << value
+          << "\n";
+  }
+  std::ostringstream* out_;
+  int indent_ = 0;
+};
+
+// Collects key paths only.
+class KeyLister {
+ public:
+  template <typename Fn>
+  void section(const char* name, Fn fn) {
+    prefix_ = std::string(name) + ".";
+    fn();
+    prefix_.clear();
+  }
+  template <typename... A>
+  void field(const char* name, A&&...) {
+    add(name);
+  }
+  template <typename... A>
+  void text(const char* name, A&&...) {
+    add(name);
+  }
+  template <typename... A>
+  void texts(const char* name, A&&...) {
+    add(name);
+  }
+  template <typename T>
+  void choice(const char* name, T&, Choices<T>) {
+    add(name);
+  }
+  template <typename... A>
+  void numbers(const char* name, A&&...) {
+    add(name);
+  }
+  template <typename... A>
+  void colour(const char* name, A&&...) {
+    add(name);
+  }
+  std::vector<std::string> keys;
+
+ private:
+  void add(const char* name) { keys.push_back(prefix_ + name); }
+  std::string prefix_;
+};
+
+}  // namespace
+
+std::string dump_config(const ServiceConfig& config) {
+  ServiceConfig copy = config;  // the schema walks mutable references
+  std::ostringstream out;
+  Writer writer(&out);
+  config_detail::describe(writer, copy);
+  return out.str();
+}
+
+std::vector<std::string> config_key_paths() {
+  ServiceConfig scratch;
+  KeyLister lister;
+  config_detail::describe(lister, scratch);
+  return lister.keys;
+}
+
+}  // namespace ceilpose

@@ -1,0 +1,155 @@
+// Each kind of bad configuration gives one precise message: file, line, key
+// path, what was expected and what was found.
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include <cstdio>
+#include <fstream>
+
+#include "config/service_config.h"
+
+namespace ceilpose {
+namespace {
+
+using ::testing::HasSubstr;
+
+std::string error_of(const std::string& yaml) {
+  auto r = load_config_string(yaml, "test.yaml");
+  EXPECT_FALSE(r) << "accepted:\n" << yaml;
+  return r ? std::string() : r.error().message;
+}
+
+TEST(ConfigLoader, EmptyTextGivesDefaults) {
+  auto r = load_config_string("", "empty.yaml");
+  ASSERT_TRUE(r) << r.error().message;
+  EXPECT_EQ(dump_config(*r), dump_config(default_config()));
+}
+
+TEST(ConfigLoader, KeyOverridesOnlyItself) {
+  auto r = load_config_string("camera:\n  fx: 600.5\n", "t.yaml");
+  ASSERT_TRUE(r) << r.error().message;
+  EXPECT_DOUBLE_EQ(r->pipeline.intrinsics.fx, 600.5);
+  EXPECT_DOUBLE_EQ(r->pipeline.intrinsics.fy, 530.0);
+}
+
+TEST(ConfigLoader, ReadsEnumsListsAndColours) {
+  auto r = load_config_string(
+      "positioning:\n  mode: lsq\ndds:\n  reliability: best_effort\n  peers: [a, b]\n"
+      "ceiling:\n  red: [1, 2, 3]\nlogging:\n  level: debug\n",
+      "t.yaml");
+  ASSERT_TRUE(r) << r.error().message;
+  EXPECT_EQ(r->positioning_mode, PositioningMode::kLeastSquares);
+  EXPECT_FALSE(r->dds.reliable);
+  EXPECT_EQ(r->dds.peers, (std::vector<std::string>{"a", "b"}));
+  EXPECT_EQ(r->pipeline.layout.red.g, 2);
+  EXPECT_EQ(r->logging.level, LogLevel::kDebug);
+}
+
+TEST(ConfigLoader, SyntaxErrorNamesFileLineAndColumn) {
+  const std::string e = error_of("camera:\n  fx: [1, 2\n");
+  EXPECT_THAT(e, HasSubstr("test.yaml:"));
+  EXPECT_THAT(e, HasSubstr("YAML syntax error"));
+}
+
+TEST(ConfigLoader, UnknownKeyNamesItsPathAndLine) {
+  const std::string e = error_of("camera:\n  fx: 530\n  focal: 3\n");
+  EXPECT_THAT(e, HasSubstr("test.yaml:3:"));
+  EXPECT_THAT(e, HasSubstr("unknown key 'camera.focal'"));
+  EXPECT_THAT(e, HasSubstr("fx"));  // lists what is known
+}
+
+TEST(ConfigLoader, UnknownSectionIsAnError) {
+  EXPECT_THAT(error_of("kamera:\n  fx: 530\n"), HasSubstr("unknown key 'kamera'"));
+}
+
+TEST(ConfigLoader, WrongTypeNamesExpectedAndFound) {
+  const std::string e = error_of("camera:\n  fx: fast\n");
+  EXPECT_THAT(e, HasSubstr("test.yaml:2: camera.fx: expected a number, found 'fast'"));
+}
+
+TEST(ConfigLoader, FractionForIntegerIsAnError) {
+  EXPECT_THAT(error_of("capture:\n  buffer_count: 2.5\n"),
+              HasSubstr("capture.buffer_count: expected an integer, found '2.5'"));
+}
+
+TEST(ConfigLoader, OutOfRangeNamesTheRange) {
+  const std::string e = error_of("\ncapture:\n  rt_priority: 120\n");
+  EXPECT_THAT(e, HasSubstr("test.yaml:3: capture.rt_priority: expected a value in [0, 99]"));
+  EXPECT_THAT(e, HasSubstr("found '120'"));
+}
+
+TEST(ConfigLoader, SectionThatIsNotAMappingIsAnError) {
+  EXPECT_THAT(error_of("camera: 5\n"), HasSubstr("camera: expected a mapping, found '5'"));
+}
+
+TEST(ConfigLoader, YesIsNotABoolean) {
+  EXPECT_THAT(error_of("filter:\n  enabled: yes\n"),
+              HasSubstr("filter.enabled: expected true or false, found 'yes'"));
+}
+
+TEST(ConfigLoader, BadChoiceListsTheChoices) {
+  EXPECT_THAT(
+      error_of("positioning:\n  mode: magic\n"),
+      HasSubstr("positioning.mode: expected one of auto axes barycentric lsq, found 'magic'"));
+}
+
+TEST(ConfigLoader, ShortDistortionListIsAnError) {
+  EXPECT_THAT(error_of("camera:\n  distortion: [0.1, 0.2]\n"),
+              HasSubstr("camera.distortion: expected a list of 5 numbers, found a list"));
+}
+
+TEST(ConfigLoader, BadSourceIsAnError) {
+  EXPECT_THAT(error_of("capture:\n  source: usb0\n"),
+              HasSubstr("capture.source: expected a source: synthetic | replay:DIR"));
+}
+
+TEST(ConfigLoader, BadShmNameIsAnError) {
+  EXPECT_THAT(error_of("ipc:\n  shm_name: pose/x\n"), HasSubstr("ipc.shm_name: expected"));
+}
+
+TEST(ConfigLoader, DuplicateKeyIsAnError) {
+  EXPECT_THAT(error_of("camera:\n  fx: 1\n  fx: 2\n"),
+              HasSubstr("test.yaml:3: camera.fx: key appears twice"));
+}
+
+TEST(ConfigLoader, CaptureSizeMustMatchCalibration) {
+  EXPECT_THAT(error_of("capture:\n  width_px: 1280\n"),
+              HasSubstr("test.yaml:2: capture.width_px: expected the camera calibration's width"));
+}
+
+TEST(ConfigLoader, TopLevelListIsAnError) {
+  EXPECT_THAT(error_of("- a\n- b\n"), HasSubstr("expected a mapping of sections"));
+}
+
+TEST(ConfigLoader, MissingFileNamesThePath) {
+  auto r = load_config_file("/nonexistent/ceilpose.yaml");
+  ASSERT_FALSE(r);
+  EXPECT_THAT(r.error().message, HasSubstr("/nonexistent/ceilpose.yaml: cannot open"));
+}
+
+TEST(ConfigLoader, FileErrorsNameTheFile) {
+  const std::string path = ::testing::TempDir() + "config_loader_test.yaml";
+  std::ofstream(path) << "camera:\n  fy: -3\n";
+  auto r = load_config_file(path);
+  std::remove(path.c_str());
+  ASSERT_FALSE(r);
+  EXPECT_THAT(r.error().message, HasSubstr(path + ":2: camera.fy: expected a value in"));
+}
+
+TEST(ConfigOverrides, CommandLineValueOverridesFile) {
+  auto r = apply_overrides(default_config(), {{"capture.source", "replay:/tmp/rec", "--source"},
+                                              {"dds.domain_id", "7", "--domain"}});
+  ASSERT_TRUE(r) << r.error().message;
+  EXPECT_EQ(r->capture.source, "replay:/tmp/rec");
+  EXPECT_EQ(r->dds.domain_id, 7);
+}
+
+TEST(ConfigOverrides, BadValueNamesTheOption) {
+  auto r = apply_overrides(default_config(), {{"dds.domain_id", "300", "--domain"}});
+  ASSERT_FALSE(r);
+  EXPECT_THAT(r.error().message,
+              HasSubstr("--domain: dds.domain_id: expected a value in [0, 230]"));
+}
+
+}  // namespace
+}  // namespace ceilpose
