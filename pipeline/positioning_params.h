@@ -1,13 +1,104 @@
 #pragma once
-// Parameters of the positioning stages and the temporal filter.
+// Parameters of the positioning stages and the temporal filter. The defaults
+// here are the single source of truth; config/ceilpose.yaml mirrors them.
+// Every field: meaning, unit, effect, when to tune.
 namespace ceilpose {
 
 struct PositioningParams {
-  int lsq_max_iterations = 10;  // Gauss-Newton iterations of the least-squares solver
+  // --- least squares (camera attitude from all marker points) ---
+  // Levenberg–Marquardt iterations per solve. Each costs one pass over the
+  // points (~1 µs per 100 points). Converges in 3–6 from the thesis-mode
+  // seed; raise only if `rms_residual_px` stays high on good views.
+  int lsq_max_iterations = 12;
+  // Stop when the parameter update is below this (metres / radians).
+  double lsq_step_tolerance = 1e-7;
+  // Huber threshold on a point's reprojection residual, pixels. Residuals
+  // above it get weight k/|r|, so one bad point cannot pull the solution.
+  // Set to ~3x the detector's point noise; lower it for cleaner images.
+  double lsq_huber_px = 1.5;
+  // A marker whose RMS residual after the solve exceeds this (pixels) is
+  // dropped and the solve repeated (a marker decoded with a wrong code that
+  // happens to be grid-consistent, or a mis-measured one).
+  double lsq_marker_reject_px = 4.0;
+  // The solution is accepted only if the inliers' RMS residual (pixels) is
+  // below this; otherwise auto falls back to the thesis modes.
+  double lsq_max_rms_px = 3.0;
+  // Fewest point correspondences (over all markers) for lsq; with fewer the
+  // 5-parameter attitude is poorly determined.
+  int lsq_min_points = 8;
+  // Solve roll/pitch tilt of the camera (true) or hold it at the mount's
+  // nominal tilt (false). Tilt costs nothing and absorbs a camera that is not
+  // quite level; hold it only for single-marker views (done automatically).
+  bool lsq_estimate_tilt = true;
+  // The tilt is reported as estimated only when freeing it lowers the
+  // robust cost by more than this many times the residual variance (a
+  // likelihood-ratio test on 2 extra parameters; 99.9% point of chi²(2) is
+  // 13.8). Estimating tilt costs ~10x the position noise of holding it, so
+  // it is freed only when the data show it. Lower to follow smaller tilts.
+  double lsq_tilt_select_chi2 = 13.8;
+  // Prior standard deviation of the tilt about the nominal mount tilt,
+  // radians, weighted as one 1-pixel residual. A guard against divergence on
+  // few, clustered points, weak enough not to bias a real tilt.
+  double lsq_tilt_prior_rad = 0.2;
+  // Fewest markers for solving tilt; with fewer, tilt is held at nominal.
+  int lsq_tilt_min_markers = 2;
+  // Also solve the lens-to-ceiling distance (usually known from config).
+  // Only for ceilings of uncertain height; it weakens the position solution.
+  bool lsq_estimate_height = false;
+
+  // --- grid consistency (rejecting markers whose code disagrees) ---
+  // Two markers agree when the camera positions they imply differ by less
+  // than this, in grid units. A misread bit moves a marker by ≥ 1 unit, so
+  // anything well below 0.5 works; larger tolerates more tilt/distortion.
+  double grid_tolerance_units = 0.3;
+  // ... and their headings differ by less than this, radians.
+  double heading_tolerance_rad = 0.35;
+
+  // --- thesis modes ---
+  // Markers are considered for the Barycentric triangle only if the triangle
+  // of their centres covers at least this area, squared grid units; rejects
+  // near-collinear triples whose areal coordinates blow up.
+  double barycentric_min_area_units2 = 0.4;
+  // Standard deviations reported in the covariance of thesis-mode poses,
+  // metres / radians (they have no residuals to derive it from). Set to the
+  // measured accuracy of those modes.
+  double thesis_sigma_m = 0.01;
+  double thesis_sigma_yaw_rad = 0.01;
+  // Covariance floor added to lsq's diagonal (metres / radians): the
+  // residual-based covariance ignores model error (calibration, height).
+  double lsq_sigma_floor_m = 0.001;
+  double lsq_sigma_floor_yaw_rad = 0.001;
 };
 
 struct FilterParams {
   bool enabled = true;  // the daemon filters; `locate` only with --filter
+  // White-acceleration process noise of the constant-velocity model:
+  // standard deviation of the acceleration, m/s² and rad/s². Larger follows
+  // manoeuvres faster but smooths less; set near the robot's real accelerations.
+  double accel_sigma_mps2 = 0.5;
+  double yaw_accel_sigma_radps2 = 1.0;
+  // Measurement standard deviation floors, metres / radians: a measurement's
+  // own covariance is used but never taken as better than this (lsq can
+  // report sub-millimetre, but model errors are not in it).
+  double meas_sigma_floor_m = 0.003;
+  double meas_sigma_floor_yaw_rad = 0.005;
+  // Gate on the squared Mahalanobis distance of the innovation (3 DOF).
+  // 16.3 is the 99.9% point of chi²(3); raise to accept faster motion.
+  double gate_chi2 = 16.3;
+  // Innovations smaller than these are never gated (metres / radians), so a
+  // very confident filter does not lock out a slightly-off good measurement.
+  double gate_min_m = 0.02;
+  double gate_min_rad = 0.03;
+  // After this many consecutive gated measurements the filter believes the
+  // measurements (the robot was moved, or the filter diverged) and
+  // re-initialises on the latest one. Counted in TemporalFilter::stats().
+  int reinit_after_gated = 5;
+  // Without a valid measurement the filter predicts for at most this long,
+  // then reports invalid until a measurement re-initialises it, milliseconds.
+  double predict_timeout_ms = 500.0;
+  // Initial velocity standard deviations, m/s and rad/s.
+  double init_velocity_sigma_mps = 0.5;
+  double init_yaw_rate_sigma_radps = 1.0;
 };
 
 }  // namespace ceilpose

@@ -1,0 +1,70 @@
+#include "pipeline/change_of_axes.h"
+
+#include <cmath>
+
+#include "pipeline/pipeline_config.h"
+
+namespace ceilpose {
+
+ViewGeometry::ViewGeometry(const PipelineConfig& config)
+    : intrinsics_(config.intrinsics),
+      mount_(config.mount),
+      layout_(config.layout),
+      depth_m_(config.layout.height_m - config.mount.lens_height_m),
+      tilt_(tilt_rotation(config.mount.tilt_x_rad, config.mount.tilt_y_rad)) {}
+
+void ViewGeometry::level_normalized(double u_px, double v_px, double* x_n, double* y_n) const {
+  double x = 0.0, y = 0.0;
+  undistort_pixel(intrinsics_, u_px, v_px, &x, &y);
+  // The camera axes in the world are Level(yaw)·tilt (core/camera_model.cpp),
+  // so tilt·ray is the ray in the level camera's frame.
+  const Vec3 r = mat_vec(tilt_, {x, y, 1.0});
+  *x_n = r[0] / r[2];
+  *y_n = r[1] / r[2];
+}
+
+Pose2D ViewGeometry::robot_from_camera(double cam_x_m, double cam_y_m, double cam_yaw_rad) const {
+  const double yaw = wrap_angle_rad(cam_yaw_rad - mount_.yaw_rad);
+  const double c = std::cos(yaw), s = std::sin(yaw);
+  return Pose2D{cam_x_m - (mount_.offset_forward_m * c - mount_.offset_left_m * s),
+                cam_y_m - (mount_.offset_forward_m * s + mount_.offset_left_m * c), yaw};
+}
+
+// Change of Axes (thesis): the marker's image offset from the image centre,
+// rotated by the heading and scaled by pixels per grid unit, is the marker's
+// position relative to the camera; translate by the marker's grid position.
+//
+// With the level camera of SPEC §3 a ceiling point at d = P − C (world) has
+// Xc = −sinψ·dx + cosψ·dy, Yc = −cosψ·dx − sinψ·dy, Zc = H − h. Working in
+// normalized coordinates (pixels / f) the scale fx·g/(H−h) becomes (H−h),
+// and the inverse rotation is the transpose:
+//   dx = −sinψ·Xc − cosψ·Yc,  dy = cosψ·Xc − sinψ·Yc.
+// World West (−1, 0) images as (Xc, Yc) ∝ (sinψ, cosψ), so the red→green
+// vector in the image gives ψ = atan2(Δx, Δy).
+bool marker_fix(const ViewGeometry& view, const MarkerObservation& marker, int index,
+                MarkerFix* fix) {
+  const CeilingLayout& layout = view.layout();
+  if (marker.code_i < 0 || marker.code_j < 0 || marker.code_i >= layout.codes() ||
+      marker.code_j >= layout.codes()) {
+    return false;
+  }
+  double xr = 0.0, yr = 0.0, xg = 0.0, yg = 0.0;
+  view.level_normalized(marker.red_u_px, marker.red_v_px, &xr, &yr);
+  view.level_normalized(marker.green_u_px, marker.green_v_px, &xg, &yg);
+  const double hx = xg - xr, hy = yg - yr;
+  // The negated test also refuses NaN from a non-finite measurement.
+  if (!(hx * hx + hy * hy >= 1e-12) || !std::isfinite(hx) || !std::isfinite(hy)) return false;
+  fix->index = index;
+  fix->world_x_m = marker.code_i * layout.grid_m;
+  fix->world_y_m = marker.code_j * layout.grid_m;
+  view.level_normalized(marker.centre_u_px, marker.centre_v_px, &fix->centre_x_n, &fix->centre_y_n);
+  if (!std::isfinite(fix->centre_x_n) || !std::isfinite(fix->centre_y_n)) return false;
+  fix->cam_yaw_rad = std::atan2(hx, hy);
+  const double s = std::sin(fix->cam_yaw_rad), c = std::cos(fix->cam_yaw_rad);
+  const double xc = view.depth_m() * fix->centre_x_n, yc = view.depth_m() * fix->centre_y_n;
+  fix->cam_x_m = fix->world_x_m - (-s * xc - c * yc);
+  fix->cam_y_m = fix->world_y_m - (c * xc - s * yc);
+  return true;
+}
+
+}  // namespace ceilpose

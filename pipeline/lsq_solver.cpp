@@ -1,0 +1,407 @@
+#include "pipeline/lsq_solver.h"
+
+#include <algorithm>
+#include <cmath>
+
+namespace ceilpose {
+namespace {
+
+constexpr int kN = 6;
+enum Param : int { kTx = 0, kTy = 1, kYaw = 2, kTiltX = 3, kTiltY = 4, kTz = 5 };
+// Marker-level rejection passes after the first solve.
+constexpr int kMaxRejections = 3;
+
+// Level camera axes for camera yaw psi (SPEC §3), row-major.
+Mat3 level_rotation(double psi) {
+  const double s = std::sin(psi), c = std::cos(psi);
+  return {-s, -c, 0.0, c, -s, 0.0, 0.0, 0.0, 1.0};
+}
+
+// Camera yaw of a possibly tilted camera: R = Level(ψ)·Rx(a)·Ry(b) has
+// Yc = (−cos a·cosψ, −cos a·sinψ, sin a), so ψ is the floor heading of −Yc
+// (image up), exact for any tilt below 90°.
+double camera_yaw(const Mat3& r) { return std::atan2(-r[4], -r[1]); }
+
+// Tilt (a, b) of R = Level(ψ)·Rx(a)·Ry(b): M = Level(ψ)ᵀR = Rx(a)Ry(b) =
+// [[cb, 0, sb], [sa·sb, ca, −sa·cb], [−ca·sb, sa, ca·cb]].
+void camera_tilt(const Mat3& r, double* a, double* b) {
+  const Mat3 m = mat_mul(mat_transpose(level_rotation(camera_yaw(r))), r);
+  *a = std::atan2(-m[5], m[8]);
+  *b = std::asin(std::clamp(m[2], -1.0, 1.0));
+}
+
+// Rotation by the vector w (Rodrigues).
+Mat3 exp_so3(const Vec3& w) {
+  const double theta = std::sqrt(w[0] * w[0] + w[1] * w[1] + w[2] * w[2]);
+  if (theta < 1e-12) return {1, 0, 0, 0, 1, 0, 0, 0, 1};
+  const double kx = w[0] / theta, ky = w[1] / theta, kz = w[2] / theta;
+  const double c = std::cos(theta), s = std::sin(theta), v = 1.0 - c;
+  return {kx * kx * v + c,      kx * ky * v - kz * s, kx * kz * v + ky * s,
+          kx * ky * v + kz * s, ky * ky * v + c,      ky * kz * v - kx * s,
+          kx * kz * v - ky * s, ky * kz * v + kx * s, kz * kz * v + c};
+}
+
+// Cholesky solve of the active block of a symmetric positive definite
+// system in place; inactive parameters get 0. False when not SPD.
+bool solve_spd(std::array<double, kN * kN> a, const std::array<bool, kN>& active,
+               std::array<double, kN> b, std::array<double, kN>* x) {
+  for (int i = 0; i < kN; ++i) {
+    if (active[i]) continue;
+    for (int j = 0; j < kN; ++j) a[i * kN + j] = a[j * kN + i] = 0.0;
+    a[i * kN + i] = 1.0;
+    b[i] = 0.0;
+  }
+  for (int j = 0; j < kN; ++j) {
+    double d = a[j * kN + j];
+    for (int k = 0; k < j; ++k) d -= a[j * kN + k] * a[j * kN + k];
+    if (!(d > 0.0)) return false;
+    d = std::sqrt(d);
+    a[j * kN + j] = d;
+    for (int i = j + 1; i < kN; ++i) {
+      double s = a[i * kN + j];
+      for (int k = 0; k < j; ++k) s -= a[i * kN + k] * a[j * kN + k];
+      a[i * kN + j] = s / d;
+    }
+  }
+  for (int i = 0; i < kN; ++i) {
+    double s = b[i];
+    for (int k = 0; k < i; ++k) s -= a[i * kN + k] * b[k];
+    b[i] = s / a[i * kN + i];
+  }
+  for (int i = kN - 1; i >= 0; --i) {
+    double s = b[i];
+    for (int k = i + 1; k < kN; ++k) s -= a[k * kN + i] * b[k];
+    b[i] = s / a[i * kN + i];
+  }
+  *x = b;
+  return true;
+}
+
+}  // namespace
+
+double LsqSolver::residual2_px(const ViewGeometry& view, const Mat3& r_cw, const Vec3& t_w,
+                               const Point& pt) {
+  const Vec3 p = mat_vec(r_cw, {pt.world[0] - t_w[0], pt.world[1] - t_w[1], pt.world[2] - t_w[2]});
+  const double rx = view.intrinsics().fx * (pt.x_n - p[0] / p[2]);
+  const double ry = view.intrinsics().fy * (pt.y_n - p[1] / p[2]);
+  return rx * rx + ry * ry;
+}
+
+// Residuals are in pixels: r = f·(observed − projected) in undistorted
+// normalized coordinates (undistorting the observations once is cheaper than
+// distorting every projection and differentiates more simply).
+//
+// Parameters: the optical centre t (x, y, and optionally z) and a rotation
+// increment applied on the left, R ← Exp(ω)·R, with ω = δψ·ẑ + δa·Xl + δb·Yl
+// (Xl, Yl the level camera's axes): δψ is exactly a yaw change and δa, δb
+// are tilt changes about the level axes. For a ceiling point P, a = P − t,
+// p = Rᵀa:  ∂p/∂t = −Rᵀ,  ∂p/∂ω = Rᵀ[a]×,  and x = X/Z, y = Y/Z give
+// ∂x/∂p = (1/Z, 0, −X/Z²), ∂y/∂p = (0, 1/Z, −Y/Z²).
+double LsqSolver::accumulate(const ViewGeometry& view, const PositioningParams& params,
+                             std::span<const bool> use, const State& st, bool with_jacobian,
+                             Normal* a, Vector* b, double* sum_w_r2, int* count) const {
+  const double fx = view.intrinsics().fx, fy = view.intrinsics().fy;
+  const double k = params.lsq_huber_px;
+  const Mat3 rt = mat_transpose(st.r_wc);
+  const double psi = camera_yaw(st.r_wc);
+  const Mat3 lev = level_rotation(psi);
+  const Vec3 axis[3] = {{0.0, 0.0, 1.0}, {lev[0], lev[3], lev[6]}, {lev[1], lev[4], lev[7]}};
+  if (with_jacobian) {
+    a->fill(0.0);
+    b->fill(0.0);
+  }
+  double cost = 0.0, wr2 = 0.0;
+  int n = 0;
+  for (int i = 0; i < point_count_; ++i) {
+    const Point& pt = points_[i];
+    if (!use[pt.fix]) continue;
+    const Vec3 d{pt.world[0] - st.t_w[0], pt.world[1] - st.t_w[1], pt.world[2] - st.t_w[2]};
+    const Vec3 p = mat_vec(rt, d);
+    if (p[2] < 1e-3) return INFINITY;  // a point behind the camera: diverged
+    const double iz = 1.0 / p[2];
+    const double rx = fx * (pt.x_n - p[0] * iz), ry = fy * (pt.y_n - p[1] * iz);
+    const double r = std::sqrt(rx * rx + ry * ry);
+    const double w = r <= k ? 1.0 : k / r;
+    cost += r <= k ? r * r : 2.0 * k * r - k * k;
+    wr2 += w * r * r;
+    ++n;
+    if (!with_jacobian) continue;
+    // dp/dparam, columns in Param order.
+    double dp[3][kN] = {};
+    for (int row = 0; row < 3; ++row) {
+      dp[row][kTx] = -rt[row * 3 + 0];
+      dp[row][kTy] = -rt[row * 3 + 1];
+      dp[row][kTz] = -rt[row * 3 + 2];
+    }
+    const int rot_cols[3] = {kYaw, kTiltX, kTiltY};
+    for (int c = 0; c < 3; ++c) {
+      const Vec3& w3 = axis[c];
+      const Vec3 cross{d[1] * w3[2] - d[2] * w3[1], d[2] * w3[0] - d[0] * w3[2],
+                       d[0] * w3[1] - d[1] * w3[0]};  // [a]×·w = a × w
+      const Vec3 col = mat_vec(rt, cross);
+      for (int row = 0; row < 3; ++row) dp[row][rot_cols[c]] = col[row];
+    }
+    double jx[kN], jy[kN];
+    for (int c = 0; c < kN; ++c) {
+      // ∂r/∂param = −f·∂(projection)/∂param
+      jx[c] = -fx * iz * (dp[0][c] - p[0] * iz * dp[2][c]);
+      jy[c] = -fy * iz * (dp[1][c] - p[1] * iz * dp[2][c]);
+    }
+    for (int r1 = 0; r1 < kN; ++r1) {
+      (*b)[r1] -= w * (jx[r1] * rx + jy[r1] * ry);
+      for (int c = r1; c < kN; ++c) (*a)[r1 * kN + c] += w * (jx[r1] * jx[c] + jy[r1] * jy[c]);
+    }
+  }
+  if (with_jacobian) {
+    for (int r1 = 0; r1 < kN; ++r1)
+      for (int c = 0; c < r1; ++c) (*a)[r1 * kN + c] = (*a)[c * kN + r1];
+  }
+  *sum_w_r2 = wr2;
+  *count = n;
+  return cost;
+}
+
+// A soft prior keeps the tilt near the mount's nominal tilt when the points
+// cannot separate it from translation (few, clustered markers); its weight
+// is that of one 1-pixel residual per lsq_tilt_prior_rad.
+double LsqSolver::prior_cost(const ViewGeometry& view, const PositioningParams& params,
+                             const State& st, Normal* a, Vector* b) const {
+  if (!active_[kTiltX]) return 0.0;
+  double ta = 0.0, tb = 0.0;
+  camera_tilt(st.r_wc, &ta, &tb);
+  const double w = 1.0 / params.lsq_tilt_prior_rad;
+  const double ra = w * (ta - view.mount().tilt_x_rad), rb = w * (tb - view.mount().tilt_y_rad);
+  if (a != nullptr) {
+    (*a)[kTiltX * kN + kTiltX] += w * w;
+    (*a)[kTiltY * kN + kTiltY] += w * w;
+    (*b)[kTiltX] -= w * ra;
+    (*b)[kTiltY] -= w * rb;
+  }
+  return ra * ra + rb * rb;
+}
+
+// Levenberg–Marquardt with Huber weights (IRLS) over the active
+// parameters; with `reject`, then drops the worst marker if its RMS residual
+// exceeds lsq_marker_reject_px and solves again from where it is. Returns
+// the robust cost (infinite if the solve diverged).
+double LsqSolver::optimise(const ViewGeometry& view, const PositioningParams& params,
+                           std::span<bool> use, std::span<const MarkerFix> fixes, bool reject,
+                           State* state, int* marker_count, int* iterations) {
+  State& st = *state;
+  Normal a{};
+  Vector b{};
+  double wr2 = 0.0, cost = INFINITY;
+  int n = 0;
+  for (int pass = 0; pass <= kMaxRejections; ++pass) {
+    double lambda = 1e-4;
+    cost = accumulate(view, params, use, st, true, &a, &b, &wr2, &n) +
+           prior_cost(view, params, st, &a, &b);
+    if (!std::isfinite(cost)) return INFINITY;
+    for (int it = 0; it < params.lsq_max_iterations; ++it, ++*iterations) {
+      Normal damped = a;
+      for (int i = 0; i < kN; ++i) damped[i * kN + i] *= 1.0 + lambda;
+      Vector step{};
+      if (!solve_spd(damped, active_, b, &step)) return INFINITY;
+      State trial = st;
+      trial.t_w[0] += step[kTx];
+      trial.t_w[1] += step[kTy];
+      trial.t_w[2] += step[kTz];
+      const Mat3 lev = level_rotation(camera_yaw(st.r_wc));
+      Vec3 w{0.0, 0.0, step[kYaw]};
+      for (int r = 0; r < 3; ++r) w[r] += step[kTiltX] * lev[r * 3] + step[kTiltY] * lev[r * 3 + 1];
+      trial.r_wc = mat_mul(exp_so3(w), st.r_wc);
+      Normal ta{};
+      Vector tb{};
+      double twr2 = 0.0;
+      int tn = 0;
+      const double trial_cost = accumulate(view, params, use, trial, true, &ta, &tb, &twr2, &tn) +
+                                prior_cost(view, params, trial, &ta, &tb);
+      if (trial_cost <= cost) {
+        st = trial;
+        cost = trial_cost;
+        a = ta;
+        b = tb;
+        lambda = std::max(lambda * 0.1, 1e-9);
+        double step_norm = 0.0;
+        for (double v : step) step_norm = std::max(step_norm, std::abs(v));
+        if (step_norm < params.lsq_step_tolerance) break;
+      } else {
+        lambda *= 10.0;
+        if (lambda > 1e6) break;
+      }
+    }
+    if (!reject || *marker_count <= 1 || pass == kMaxRejections) break;
+    // Per-marker RMS residual; the worst offender is dropped if too large.
+    int worst = -1;
+    double worst_rms2 = params.lsq_marker_reject_px * params.lsq_marker_reject_px;
+    const Mat3 rt = mat_transpose(st.r_wc);
+    for (int f = 0; f < static_cast<int>(fixes.size()); ++f) {
+      if (!use[f]) continue;
+      double sum = 0.0;
+      int cnt = 0;
+      for (int i = 0; i < point_count_; ++i) {
+        const Point& pt = points_[i];
+        if (pt.fix != f) continue;
+        sum += residual2_px(view, rt, st.t_w, pt);
+        ++cnt;
+      }
+      if (cnt > 0 && sum / cnt > worst_rms2) {
+        worst_rms2 = sum / cnt;
+        worst = f;
+      }
+    }
+    if (worst < 0) break;
+    use[worst] = false;
+    --*marker_count;
+    if (*marker_count < params.lsq_tilt_min_markers) active_[kTiltX] = active_[kTiltY] = false;
+  }
+  return cost;
+}
+
+bool LsqSolver::solve(const ViewGeometry& view, const PositioningParams& params,
+                      std::span<const MarkerObservation> markers, std::span<const MarkerFix> fixes,
+                      std::span<bool> use, LsqResult* out) {
+  const CeilingLayout& layout = view.layout();
+  // 1. Correspondences of the markers in use; a marker without measured
+  // points still gives its centre and its two rectangle centres.
+  point_count_ = 0;
+  int marker_count = 0;
+  double sin_sum = 0.0, cos_sum = 0.0, x_sum = 0.0, y_sum = 0.0;
+  for (int f = 0; f < static_cast<int>(fixes.size()); ++f) {
+    if (!use[f]) continue;
+    const MarkerFix& fix = fixes[f];
+    const MarkerObservation& m = markers[fix.index];
+    auto add = [&](double e_m, double n_m, double u_px, double v_px) {
+      if (point_count_ >= static_cast<int>(points_.size())) return;
+      if (!std::isfinite(u_px) || !std::isfinite(v_px) || !std::isfinite(e_m) ||
+          !std::isfinite(n_m)) {
+        return;
+      }
+      Point& p = points_[point_count_++];
+      undistort_pixel(view.intrinsics(), u_px, v_px, &p.x_n, &p.y_n);
+      p.world = {fix.world_x_m + e_m, fix.world_y_m + n_m, layout.height_m};
+      p.fix = f;
+    };
+    if (m.point_count > 0) {
+      for (int k = 0; k < std::min(m.point_count, kMaxPointsPerMarker); ++k) {
+        add(m.points[k].e_m, m.points[k].n_m, m.points[k].u_px, m.points[k].v_px);
+      }
+    } else {
+      add(0.0, 0.0, m.centre_u_px, m.centre_v_px);
+      add(layout.red_centre_e_m(), 0.0, m.red_u_px, m.red_v_px);
+      add(layout.green_centre_e_m(), 0.0, m.green_u_px, m.green_v_px);
+    }
+    ++marker_count;
+    sin_sum += std::sin(fix.cam_yaw_rad);
+    cos_sum += std::cos(fix.cam_yaw_rad);
+    x_sum += fix.cam_x_m;
+    y_sum += fix.cam_y_m;
+  }
+  if (marker_count == 0 || point_count_ < params.lsq_min_points) return false;
+
+  // 2. Seed: the Change of Axes answers averaged, nominal tilt and height.
+  State st;
+  st.t_w = {x_sum / marker_count, y_sum / marker_count, view.mount().lens_height_m};
+  st.r_wc = mat_mul(level_rotation(std::atan2(sin_sum, cos_sum)), view.tilt());
+  active_ = {true, true, true, false, false, params.lsq_estimate_height};
+
+  // 3. Free tilt first (robust to a real tilt's large residuals, and it
+  // rejects outlier markers), then the same markers with the tilt held at
+  // nominal. The held model wins unless freeing the tilt explains the points
+  // significantly better: tilt trades off against translation so closely
+  // that estimating it costs ~10x the position noise of holding it, and a
+  // tilt too small to be detected is also too small to matter.
+  const bool tilt_allowed = params.lsq_estimate_tilt && marker_count >= params.lsq_tilt_min_markers;
+  active_[kTiltX] = active_[kTiltY] = tilt_allowed;
+  int iterations = 0;
+  double cost = optimise(view, params, use, fixes, true, &st, &marker_count, &iterations);
+  if (!std::isfinite(cost)) return false;
+  bool tilt_estimated = tilt_allowed && marker_count >= params.lsq_tilt_min_markers;
+  if (tilt_estimated) {
+    Normal a{};
+    Vector b{};
+    double wr2 = 0.0;
+    int n = 0;
+    accumulate(view, params, use, st, false, &a, &b, &wr2, &n);
+    int p_free = 0;
+    for (bool act : active_) p_free += act ? 1 : 0;
+    const double sigma2 = cost / std::max(1, 2 * n - p_free);
+    State held = st;
+    held.r_wc = mat_mul(level_rotation(camera_yaw(st.r_wc)), view.tilt());
+    active_[kTiltX] = active_[kTiltY] = false;
+    const double held_cost =
+        optimise(view, params, use, fixes, false, &held, &marker_count, &iterations);
+    if (std::isfinite(held_cost) && held_cost - cost <= params.lsq_tilt_select_chi2 * sigma2) {
+      st = held;
+      cost = held_cost;
+      tilt_estimated = false;
+    } else {
+      active_[kTiltX] = active_[kTiltY] = true;
+    }
+  } else {
+    active_[kTiltX] = active_[kTiltY] = false;
+  }
+  Normal a{};
+  Vector b{};
+  double wr2 = 0.0;
+  int n = 0;
+  accumulate(view, params, use, st, true, &a, &b, &wr2, &n);
+  prior_cost(view, params, st, &a, &b);
+
+  // 4. Accept only a solution that explains the points.
+  double sum_r2 = 0.0;
+  {
+    const Mat3 rt = mat_transpose(st.r_wc);
+    for (int i = 0; i < point_count_; ++i) {
+      const Point& pt = points_[i];
+      if (!use[pt.fix]) continue;
+      sum_r2 += residual2_px(view, rt, st.t_w, pt);
+    }
+  }
+  if (n < params.lsq_min_points) return false;
+  const double rms = std::sqrt(sum_r2 / n);
+  if (!(rms <= params.lsq_max_rms_px)) return false;
+
+  // 5. Covariance: σ²·(JᵀWJ)⁻¹ with σ² = Σw·r²/(m − p) (m residual
+  // components, p parameters), marginalised to (t_x, t_y, ψ) by taking that
+  // block of the inverse, then carried to the robot's (x, y, yaw) through the
+  // mount offset: x = tx − (f·cos yaw − l·sin yaw), y = ty − (f·sin yaw + l·cos yaw).
+  int p_count = 0;
+  for (bool act : active_) p_count += act ? 1 : 0;
+  const double dof = std::max(1, 2 * n - p_count);
+  const double sigma2 = wr2 / dof;
+  Normal inv_cols{};
+  for (int c = 0; c < 3; ++c) {
+    Vector e{};
+    e[c] = 1.0;
+    Vector col{};
+    if (!solve_spd(a, active_, e, &col)) return false;
+    for (int r = 0; r < 3; ++r) inv_cols[r * 3 + c] = sigma2 * col[r];
+  }
+  const double psi = camera_yaw(st.r_wc);
+  out->robot = view.robot_from_camera(st.t_w[0], st.t_w[1], psi);
+  const double cy = std::cos(out->robot.yaw_rad), sy = std::sin(out->robot.yaw_rad);
+  const double fwd = view.mount().offset_forward_m, left = view.mount().offset_left_m;
+  const double j[9] = {1.0, 0.0, fwd * sy + left * cy, 0.0, 1.0, -(fwd * cy - left * sy), 0.0,
+                       0.0, 1.0};
+  for (int r = 0; r < 3; ++r)
+    for (int c = 0; c < 3; ++c) {
+      double s = 0.0;
+      for (int k1 = 0; k1 < 3; ++k1)
+        for (int k2 = 0; k2 < 3; ++k2) s += j[r * 3 + k1] * inv_cols[k1 * 3 + k2] * j[c * 3 + k2];
+      out->covariance[r * 3 + c] = s;
+    }
+  out->covariance[0] += params.lsq_sigma_floor_m * params.lsq_sigma_floor_m;
+  out->covariance[4] += params.lsq_sigma_floor_m * params.lsq_sigma_floor_m;
+  out->covariance[8] += params.lsq_sigma_floor_yaw_rad * params.lsq_sigma_floor_yaw_rad;
+  out->rms_px = rms;
+  out->markers = marker_count;
+  out->points = n;
+  out->iterations = iterations;
+  camera_tilt(st.r_wc, &out->tilt_x_rad, &out->tilt_y_rad);
+  out->lens_height_m = st.t_w[2];
+  out->tilt_estimated = tilt_estimated;
+  return true;
+}
+
+}  // namespace ceilpose

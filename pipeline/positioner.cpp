@@ -1,0 +1,106 @@
+#include "pipeline/positioner.h"
+
+#include <cmath>
+
+#include "pipeline/barycentric.h"
+#include "pipeline/grid_consistency.h"
+
+namespace ceilpose {
+
+Positioner::Positioner(const PipelineConfig& config) : params_(config.positioning), view_(config) {}
+
+void Positioner::set_thesis_covariance(PoseEstimate* estimate) const {
+  estimate->covariance.fill(0.0);
+  estimate->covariance[0] = estimate->covariance[4] =
+      params_.thesis_sigma_m * params_.thesis_sigma_m;
+  estimate->covariance[8] = params_.thesis_sigma_yaw_rad * params_.thesis_sigma_yaw_rad;
+}
+
+// Thesis Change of Axes uses one marker: the consistent one nearest the
+// image centre, where tilt and distortion errors are smallest.
+PoseEstimate Positioner::change_of_axes(int fix_count) const {
+  PoseEstimate est;
+  int best = -1;
+  double best_r2 = 0.0;
+  for (int k = 0; k < fix_count; ++k) {
+    if (!inlier_[k]) continue;
+    const double r2 =
+        fixes_[k].centre_x_n * fixes_[k].centre_x_n + fixes_[k].centre_y_n * fixes_[k].centre_y_n;
+    if (best < 0 || r2 < best_r2) {
+      best = k;
+      best_r2 = r2;
+    }
+  }
+  if (best < 0) return est;
+  const MarkerFix& f = fixes_[best];
+  est.pose = view_.robot_from_camera(f.cam_x_m, f.cam_y_m, f.cam_yaw_rad);
+  est.valid = true;
+  est.mode = PositioningMode::kChangeOfAxes;
+  est.markers = 1;
+  set_thesis_covariance(&est);
+  return est;
+}
+
+PoseEstimate Positioner::barycentric(int fix_count) const {
+  PoseEstimate est;
+  if (!solve_barycentric(view_, params_, std::span(fixes_.data(), fix_count),
+                         std::span(inlier_.data(), fix_count), &est.pose)) {
+    return est;
+  }
+  est.valid = true;
+  est.mode = PositioningMode::kBarycentric;
+  est.markers = 3;
+  set_thesis_covariance(&est);
+  return est;
+}
+
+PoseEstimate Positioner::least_squares(std::span<const MarkerObservation> markers, int fix_count) {
+  PoseEstimate est;
+  for (int k = 0; k < fix_count; ++k) use_[k] = inlier_[k];
+  lsq_result_ = LsqResult{};
+  if (!lsq_.solve(view_, params_, markers, std::span(fixes_.data(), fix_count),
+                  std::span(use_.data(), fix_count), &lsq_result_)) {
+    return est;
+  }
+  est.valid = true;
+  est.pose = lsq_result_.robot;
+  est.covariance = lsq_result_.covariance;
+  est.mode = PositioningMode::kLeastSquares;
+  est.markers = lsq_result_.markers;
+  est.rms_residual_px = lsq_result_.rms_px;
+  return est;
+}
+
+PoseEstimate Positioner::solve(std::span<const MarkerObservation> markers, PositioningMode mode) {
+  // 1. What each whole marker says on its own (Change of Axes).
+  int fix_count = 0;
+  const int n = static_cast<int>(std::min<size_t>(markers.size(), kMaxMarkersPerFrame));
+  for (int k = 0; k < n; ++k) {
+    if (!markers[k].whole) continue;
+    if (marker_fix(view_, markers[k], k, &fixes_[fix_count])) ++fix_count;
+  }
+  // 2. Keep the markers that agree on where the camera is.
+  const int inliers =
+      grid_consistent_subset(params_, view_.layout().grid_m, std::span(fixes_.data(), fix_count),
+                             std::span(inlier_.data(), fix_count));
+  PoseEstimate est;
+  if (inliers == 0) return est;
+  // 3. The mode asked for, or in auto the best the view allows.
+  switch (mode) {
+    case PositioningMode::kChangeOfAxes:
+      return change_of_axes(fix_count);
+    case PositioningMode::kBarycentric:
+      return barycentric(fix_count);
+    case PositioningMode::kLeastSquares:
+      return least_squares(markers, fix_count);
+    case PositioningMode::kAuto:
+      break;
+  }
+  est = least_squares(markers, fix_count);
+  if (est.valid) return est;
+  est = barycentric(fix_count);
+  if (est.valid) return est;
+  return change_of_axes(fix_count);
+}
+
+}  // namespace ceilpose

@@ -1,0 +1,46 @@
+#pragma once
+// Positioning: from the decoded markers of one frame to the robot's pose, by
+// the mode asked for (or the best one the view allows, in auto).
+#include <array>
+#include <span>
+
+#include "pipeline/change_of_axes.h"
+#include "pipeline/lsq_solver.h"
+#include "pipeline/marker_observation.h"
+#include "pipeline/pipeline_config.h"
+#include "pipeline/pose_estimate.h"
+
+namespace ceilpose {
+
+// Not thread-safe: one instance per pipeline thread. solve() allocates
+// nothing and throws nothing.
+class Positioner {
+ public:
+  explicit Positioner(const PipelineConfig& config);
+
+  // Uses whole markers only (a cut-off marker's code may be misread). The
+  // estimate is invalid when no whole marker is seen, the markers disagree
+  // with no majority, or the mode asked for cannot be applied to this view
+  // (e.g. barycentric with fewer than three markers) — never a made-up pose.
+  PoseEstimate solve(std::span<const MarkerObservation> markers, PositioningMode mode);
+
+  // Details of the last least-squares solve (tilt, iterations), for
+  // diagnostics and tests.
+  const LsqResult& last_lsq() const { return lsq_result_; }
+
+ private:
+  PoseEstimate change_of_axes(int fix_count) const;
+  PoseEstimate barycentric(int fix_count) const;
+  PoseEstimate least_squares(std::span<const MarkerObservation> markers, int fix_count);
+  void set_thesis_covariance(PoseEstimate* estimate) const;
+
+  PositioningParams params_;
+  ViewGeometry view_;
+  LsqSolver lsq_;
+  LsqResult lsq_result_;
+  std::array<MarkerFix, kMaxMarkersPerFrame> fixes_{};
+  std::array<bool, kMaxMarkersPerFrame> inlier_{};
+  std::array<bool, kMaxMarkersPerFrame> use_{};
+};
+
+}  // namespace ceilpose

@@ -1,0 +1,171 @@
+#include "pipeline/temporal_filter.h"
+
+#include <algorithm>
+#include <cmath>
+
+namespace ceilpose {
+namespace {
+
+// Inverse of a symmetric 3x3 matrix; false when singular.
+bool invert3(const std::array<double, 9>& m, std::array<double, 9>* inv) {
+  const double c00 = m[4] * m[8] - m[5] * m[7];
+  const double c01 = m[5] * m[6] - m[3] * m[8];
+  const double c02 = m[3] * m[7] - m[4] * m[6];
+  const double det = m[0] * c00 + m[1] * c01 + m[2] * c02;
+  if (!(std::abs(det) > 1e-300)) return false;
+  const double id = 1.0 / det;
+  *inv = {c00 * id, (m[2] * m[7] - m[1] * m[8]) * id, (m[1] * m[5] - m[2] * m[4]) * id,
+          c01 * id, (m[0] * m[8] - m[2] * m[6]) * id, (m[2] * m[3] - m[0] * m[5]) * id,
+          c02 * id, (m[1] * m[6] - m[0] * m[7]) * id, (m[0] * m[4] - m[1] * m[3]) * id};
+  return true;
+}
+
+}  // namespace
+
+TemporalFilter::TemporalFilter(const FilterParams& params) : params_(params) {}
+
+void TemporalFilter::reset() {
+  initialised_ = false;
+  consecutive_gated_ = 0;
+}
+
+void TemporalFilter::initialise(const PoseEstimate& m, int64_t timestamp_ns) {
+  state_ = {m.pose.x_m, m.pose.y_m, m.pose.yaw_rad, 0.0, 0.0, 0.0};
+  cov_.fill(0.0);
+  for (int r = 0; r < 3; ++r)
+    for (int c = 0; c < 3; ++c) cov_[r * kN + c] = m.covariance[r * 3 + c];
+  const double floor_m2 = params_.meas_sigma_floor_m * params_.meas_sigma_floor_m;
+  const double floor_rad2 = params_.meas_sigma_floor_yaw_rad * params_.meas_sigma_floor_yaw_rad;
+  cov_[0 * kN + 0] = std::max(cov_[0 * kN + 0], floor_m2);
+  cov_[1 * kN + 1] = std::max(cov_[1 * kN + 1], floor_m2);
+  cov_[2 * kN + 2] = std::max(cov_[2 * kN + 2], floor_rad2);
+  const double v2 = params_.init_velocity_sigma_mps * params_.init_velocity_sigma_mps;
+  cov_[3 * kN + 3] = cov_[4 * kN + 4] = v2;
+  cov_[5 * kN + 5] = params_.init_yaw_rate_sigma_radps * params_.init_yaw_rate_sigma_radps;
+  initialised_ = true;
+  last_ns_ = last_measurement_ns_ = timestamp_ns;
+  consecutive_gated_ = 0;
+  last_mode_ = m.mode;
+}
+
+// Constant velocity with white acceleration noise (discrete): per axis
+// F = [[1, dt], [0, 1]], Q = σa²·[[dt⁴/4, dt³/2], [dt³/2, dt²]].
+void TemporalFilter::predict(double dt) {
+  if (dt <= 0.0) return;
+  for (int a = 0; a < 3; ++a) state_[a] += dt * state_[a + 3];
+  state_[2] = wrap_angle_rad(state_[2]);
+  // P ← F P Fᵀ with F = I + dt·E, E mapping velocity i+3 into position i.
+  std::array<double, kN* kN> fp = cov_;
+  for (int a = 0; a < 3; ++a)
+    for (int c = 0; c < kN; ++c) fp[a * kN + c] += dt * cov_[(a + 3) * kN + c];
+  std::array<double, kN* kN> p = fp;
+  for (int r = 0; r < kN; ++r)
+    for (int a = 0; a < 3; ++a) p[r * kN + a] += dt * fp[r * kN + a + 3];
+  const double sigma[3] = {params_.accel_sigma_mps2, params_.accel_sigma_mps2,
+                           params_.yaw_accel_sigma_radps2};
+  for (int a = 0; a < 3; ++a) {
+    const double s2 = sigma[a] * sigma[a];
+    p[a * kN + a] += s2 * dt * dt * dt * dt / 4.0;
+    p[a * kN + a + 3] += s2 * dt * dt * dt / 2.0;
+    p[(a + 3) * kN + a] += s2 * dt * dt * dt / 2.0;
+    p[(a + 3) * kN + a + 3] += s2 * dt * dt;
+  }
+  cov_ = p;
+}
+
+PoseEstimate TemporalFilter::output(const PoseEstimate* used) const {
+  PoseEstimate out;
+  out.valid = true;
+  out.pose = {state_[0], state_[1], wrap_angle_rad(state_[2])};
+  for (int r = 0; r < 3; ++r)
+    for (int c = 0; c < 3; ++c) out.covariance[r * 3 + c] = cov_[r * kN + c];
+  out.mode = used != nullptr ? used->mode : last_mode_;
+  out.markers = used != nullptr ? used->markers : 0;
+  out.rms_residual_px = used != nullptr ? used->rms_residual_px : 0.0;
+  return out;
+}
+
+PoseEstimate TemporalFilter::update(const PoseEstimate& m, int64_t timestamp_ns) {
+  const double timeout_ns = params_.predict_timeout_ms * 1e6;
+  if (initialised_ && static_cast<double>(timestamp_ns - last_measurement_ns_) > timeout_ns) {
+    initialised_ = false;
+    ++stats_.timeouts;
+  }
+  if (!initialised_) {
+    if (!m.valid) return PoseEstimate{};
+    initialise(m, timestamp_ns);
+    ++stats_.updates;
+    return output(&m);
+  }
+  predict(std::max<int64_t>(0, timestamp_ns - last_ns_) * 1e-9);
+  last_ns_ = std::max(last_ns_, timestamp_ns);
+  if (!m.valid) {
+    ++stats_.predictions;
+    return output(nullptr);
+  }
+
+  // Innovation y = z − H·x (yaw wrapped), S = P₃₃ + R.
+  const double y[3] = {m.pose.x_m - state_[0], m.pose.y_m - state_[1],
+                       wrap_angle_rad(m.pose.yaw_rad - state_[2])};
+  std::array<double, 9> r = m.covariance;
+  const double floor_m2 = params_.meas_sigma_floor_m * params_.meas_sigma_floor_m;
+  const double floor_rad2 = params_.meas_sigma_floor_yaw_rad * params_.meas_sigma_floor_yaw_rad;
+  r[0] = std::max(r[0], floor_m2);
+  r[4] = std::max(r[4], floor_m2);
+  r[8] = std::max(r[8], floor_rad2);
+  std::array<double, 9> s{};
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j) s[i * 3 + j] = cov_[i * kN + j] + r[i * 3 + j];
+  std::array<double, 9> s_inv{};
+  if (!invert3(s, &s_inv)) {
+    ++stats_.predictions;
+    return output(nullptr);
+  }
+  double d2 = 0.0;
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j) d2 += y[i] * s_inv[i * 3 + j] * y[j];
+  const bool small =
+      std::hypot(y[0], y[1]) <= params_.gate_min_m && std::abs(y[2]) <= params_.gate_min_rad;
+  if (d2 > params_.gate_chi2 && !small) {
+    ++stats_.gated;
+    if (++consecutive_gated_ >= params_.reinit_after_gated) {
+      // The measurements have agreed with each other, not with us, for long
+      // enough: the robot was moved or the filter diverged.
+      ++stats_.reinitialisations;
+      initialise(m, timestamp_ns);
+      return output(&m);
+    }
+    ++stats_.predictions;
+    return output(nullptr);
+  }
+
+  // K = P Hᵀ S⁻¹ (6x3); x += K y; P −= K H P.
+  std::array<double, kN * 3> k{};
+  for (int i = 0; i < kN; ++i)
+    for (int j = 0; j < 3; ++j) {
+      double sum = 0.0;
+      for (int l = 0; l < 3; ++l) sum += cov_[i * kN + l] * s_inv[l * 3 + j];
+      k[i * 3 + j] = sum;
+    }
+  for (int i = 0; i < kN; ++i)
+    for (int j = 0; j < 3; ++j) state_[i] += k[i * 3 + j] * y[j];
+  state_[2] = wrap_angle_rad(state_[2]);
+  std::array<double, kN* kN> p = cov_;
+  for (int i = 0; i < kN; ++i)
+    for (int c = 0; c < kN; ++c) {
+      double sum = 0.0;
+      for (int j = 0; j < 3; ++j) sum += k[i * 3 + j] * cov_[j * kN + c];
+      p[i * kN + c] -= sum;
+    }
+  for (int i = 0; i < kN; ++i)  // keep P symmetric against round-off
+    for (int c = i + 1; c < kN; ++c)
+      p[i * kN + c] = p[c * kN + i] = 0.5 * (p[i * kN + c] + p[c * kN + i]);
+  cov_ = p;
+  consecutive_gated_ = 0;
+  last_measurement_ns_ = timestamp_ns;
+  last_mode_ = m.mode;
+  ++stats_.updates;
+  return output(&m);
+}
+
+}  // namespace ceilpose

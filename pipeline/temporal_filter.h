@@ -1,0 +1,53 @@
+#pragma once
+// Temporal filter of the daemon: a constant-velocity Kalman filter on
+// (x, y, yaw) with yaw wrapping, gating of jumps, counted re-initialisation
+// and prediction through missing frames up to a timeout.
+#include <array>
+#include <cstdint>
+
+#include "pipeline/pose_estimate.h"
+#include "pipeline/positioning_params.h"
+
+namespace ceilpose {
+
+struct FilterStats {
+  uint64_t updates = 0;            // measurements fused
+  uint64_t gated = 0;              // measurements refused as jumps
+  uint64_t reinitialisations = 0;  // re-starts after reinit_after_gated gated in a row
+  uint64_t predictions = 0;        // outputs predicted without a measurement
+  uint64_t timeouts = 0;           // times the filter gave up after predict_timeout_ms
+};
+
+// Not thread-safe: one instance, called from the pipeline thread in frame
+// order. update() allocates nothing and throws nothing.
+class TemporalFilter {
+ public:
+  explicit TemporalFilter(const FilterParams& params);
+
+  // Fuses one frame's estimate (valid or not) taken at `timestamp_ns`
+  // (monotonic) and returns the filtered pose; invalid until a first valid
+  // measurement and again once predict_timeout_ms passes without one. A
+  // timestamp earlier than the previous one is treated as the same instant.
+  PoseEstimate update(const PoseEstimate& measurement, int64_t timestamp_ns);
+  void reset();
+
+  const FilterStats& stats() const { return stats_; }
+
+ private:
+  static constexpr int kN = 6;  // x, y, yaw, vx, vy, vyaw
+  void initialise(const PoseEstimate& measurement, int64_t timestamp_ns);
+  void predict(double dt_s);
+  PoseEstimate output(const PoseEstimate* used) const;
+
+  FilterParams params_;
+  FilterStats stats_;
+  bool initialised_ = false;
+  std::array<double, kN> state_{};
+  std::array<double, kN * kN> cov_{};
+  int64_t last_ns_ = 0;              // time the state refers to
+  int64_t last_measurement_ns_ = 0;  // last fused (or initialising) measurement
+  int consecutive_gated_ = 0;
+  PositioningMode last_mode_ = PositioningMode::kAuto;
+};
+
+}  // namespace ceilpose

@@ -1,0 +1,188 @@
+#include "pipeline/lsq_solver.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "pipeline/pipeline_config.h"
+#include "pipeline/positioner.h"
+#include "positioning_support.h"
+
+namespace ceilpose {
+namespace {
+
+double position_error_m(const PoseEstimate& est, const Pose2D& truth) {
+  return std::hypot(est.pose.x_m - truth.x_m, est.pose.y_m - truth.y_m);
+}
+
+TEST(LeastSquares, RecoversExactPose) {
+  PipelineConfig config;
+  Positioner positioner(config);
+  testing::SyntheticView view;
+  const Pose2D robot{2.2, 1.9, 2.8};
+  const PoseEstimate est =
+      positioner.solve(testing::observe(view, robot), PositioningMode::kLeastSquares);
+  ASSERT_TRUE(est.valid);
+  EXPECT_EQ(est.mode, PositioningMode::kLeastSquares);
+  EXPECT_LT(position_error_m(est, robot), 1e-6);
+  EXPECT_NEAR(wrap_angle_rad(est.pose.yaw_rad - robot.yaw_rad), 0.0, 1e-6);
+  EXPECT_LT(est.rms_residual_px, 1e-4);
+}
+
+TEST(LeastSquares, RecoversRobotPositionUnderUnknownTilt) {
+  PipelineConfig config;  // configured level; the real camera is tilted 3°
+  Positioner positioner(config);
+  testing::SyntheticView view;
+  view.mount.tilt_x_rad = 0.04;
+  view.mount.tilt_y_rad = -0.03;
+  const Pose2D robot{2.0, 2.4, 0.9};
+  const PoseEstimate est =
+      positioner.solve(testing::observe(view, robot), PositioningMode::kLeastSquares);
+  ASSERT_TRUE(est.valid);
+  // Change of Axes would be off by (H−h)·tan(3°) ≈ 11 cm.
+  EXPECT_LT(position_error_m(est, robot), 1e-3);
+  EXPECT_NEAR(wrap_angle_rad(est.pose.yaw_rad - robot.yaw_rad), 0.0, 1e-3);
+  EXPECT_NEAR(positioner.last_lsq().tilt_x_rad, 0.04, 1e-3);
+  EXPECT_NEAR(positioner.last_lsq().tilt_y_rad, -0.03, 1e-3);
+}
+
+TEST(LeastSquares, TiltedViewFoolsChangeOfAxesButNotLeastSquares) {
+  PipelineConfig config;
+  Positioner positioner(config);
+  testing::SyntheticView view;
+  view.mount.tilt_x_rad = 0.05;
+  const Pose2D robot{2.0, 2.4, 0.0};
+  const auto markers = testing::observe(view, robot);
+  const PoseEstimate axes = positioner.solve(markers, PositioningMode::kChangeOfAxes);
+  const PoseEstimate lsq = positioner.solve(markers, PositioningMode::kLeastSquares);
+  ASSERT_TRUE(axes.valid);
+  ASSERT_TRUE(lsq.valid);
+  EXPECT_GT(position_error_m(axes, robot), 0.05);
+  EXPECT_LT(position_error_m(lsq, robot), 1e-3);
+}
+
+TEST(LeastSquares, RejectsOutlierMarkerWithWrongCode) {
+  PipelineConfig config;
+  Positioner positioner(config);
+  testing::SyntheticView view;
+  view.noise_px = 0.2;
+  const Pose2D robot{2.1, 2.0, -0.6};
+  auto markers = testing::observe(view, robot);
+  ASSERT_GE(markers.size(), 5u);
+  markers[2].code_i ^= 2;
+  const PoseEstimate est = positioner.solve(markers, PositioningMode::kLeastSquares);
+  ASSERT_TRUE(est.valid);
+  EXPECT_EQ(est.markers, static_cast<int>(markers.size()) - 1);
+  EXPECT_LT(position_error_m(est, robot), 3e-3);
+}
+
+TEST(LeastSquares, DropsMarkerWhosePointsAreBadlyMeasured) {
+  PipelineConfig config;
+  Positioner positioner(config);
+  testing::SyntheticView view;
+  view.noise_px = 0.2;
+  const Pose2D robot{2.1, 2.0, 1.0};
+  auto markers = testing::observe(view, robot);
+  ASSERT_GE(markers.size(), 5u);
+  // Consistent code, but every point of one marker shifted by 8 px.
+  for (int k = 0; k < markers[3].point_count; ++k) markers[3].points[k].u_px += 8.0;
+  const PoseEstimate est = positioner.solve(markers, PositioningMode::kLeastSquares);
+  ASSERT_TRUE(est.valid);
+  EXPECT_EQ(est.markers, static_cast<int>(markers.size()) - 1);
+  EXPECT_LT(position_error_m(est, robot), 3e-3);
+}
+
+TEST(LeastSquares, CovarianceIsPositiveDefinite) {
+  PipelineConfig config;
+  Positioner positioner(config);
+  testing::SyntheticView view;
+  view.noise_px = 0.3;
+  const PoseEstimate est =
+      positioner.solve(testing::observe(view, {1.8, 2.2, 0.3}), PositioningMode::kLeastSquares);
+  ASSERT_TRUE(est.valid);
+  const auto& c = est.covariance;
+  // Sylvester: all leading minors positive.
+  EXPECT_GT(c[0], 0.0);
+  EXPECT_GT(c[0] * c[4] - c[1] * c[3], 0.0);
+  const double det = c[0] * (c[4] * c[8] - c[5] * c[7]) - c[1] * (c[3] * c[8] - c[5] * c[6]) +
+                     c[2] * (c[3] * c[7] - c[4] * c[6]);
+  EXPECT_GT(det, 0.0);
+  EXPECT_NEAR(c[1], c[3], 1e-15);
+}
+
+TEST(LeastSquares, CovarianceShrinksWithMoreMarkers) {
+  PipelineConfig config;
+  config.positioning.lsq_sigma_floor_m = 0.0;
+  config.positioning.lsq_sigma_floor_yaw_rad = 0.0;
+  Positioner positioner(config);
+  testing::SyntheticView view;
+  view.noise_px = 0.3;
+  const Pose2D robot{2.0, 2.0, 0.2};
+  auto markers = testing::observe(view, robot);
+  ASSERT_GE(markers.size(), 8u);
+  const PoseEstimate all = positioner.solve(markers, PositioningMode::kLeastSquares);
+  markers.resize(2);
+  const PoseEstimate two = positioner.solve(markers, PositioningMode::kLeastSquares);
+  ASSERT_TRUE(all.valid);
+  ASSERT_TRUE(two.valid);
+  EXPECT_LT(all.covariance[0], two.covariance[0]);
+  EXPECT_LT(all.covariance[4], two.covariance[4]);
+  EXPECT_LT(all.covariance[8], two.covariance[8]);
+}
+
+TEST(LeastSquares, CovarianceMatchesScatterOfNoisySolutions) {
+  PipelineConfig config;
+  config.positioning.lsq_sigma_floor_m = 0.0;
+  Positioner positioner(config);
+  testing::SyntheticView view;
+  view.noise_px = 0.5;
+  const Pose2D robot{2.0, 2.0, 0.2};
+  double sum_sq = 0.0, sum_var = 0.0;
+  const int trials = 60;
+  for (int t = 0; t < trials; ++t) {
+    view.seed = 100 + t;
+    const PoseEstimate est =
+        positioner.solve(testing::observe(view, robot), PositioningMode::kLeastSquares);
+    ASSERT_TRUE(est.valid);
+    sum_sq += (est.pose.x_m - robot.x_m) * (est.pose.x_m - robot.x_m);
+    sum_var += est.covariance[0];
+  }
+  // Reported variance within a factor 2 of the observed scatter.
+  const double ratio = sum_sq / sum_var;
+  EXPECT_GT(ratio, 0.5);
+  EXPECT_LT(ratio, 2.0);
+}
+
+TEST(LeastSquares, SingleMarkerHoldsTiltAndStillSolves) {
+  PipelineConfig config;
+  Positioner positioner(config);
+  testing::SyntheticView view;
+  const Pose2D robot{2.0, 2.0, 0.5};
+  auto markers = testing::observe(view, robot);
+  markers.resize(1);
+  const PoseEstimate est = positioner.solve(markers, PositioningMode::kLeastSquares);
+  ASSERT_TRUE(est.valid);
+  EXPECT_EQ(est.markers, 1);
+  EXPECT_LT(position_error_m(est, robot), 1e-6);
+}
+
+TEST(LeastSquares, RemovesMountOffsetAndYawWithDistortion) {
+  PipelineConfig config;
+  config.mount.offset_forward_m = 0.2;
+  config.mount.offset_left_m = 0.07;
+  config.mount.yaw_rad = -1.2;
+  config.intrinsics.distortion = {-0.12, 0.03, 0.001, -0.0015, -0.004};
+  Positioner positioner(config);
+  testing::SyntheticView view;
+  view.mount = config.mount;
+  view.intrinsics = config.intrinsics;
+  const Pose2D robot{1.5, 2.5, 3.0};
+  const PoseEstimate est =
+      positioner.solve(testing::observe(view, robot), PositioningMode::kLeastSquares);
+  ASSERT_TRUE(est.valid);
+  EXPECT_LT(position_error_m(est, robot), 1e-5);
+  EXPECT_NEAR(wrap_angle_rad(est.pose.yaw_rad - robot.yaw_rad), 0.0, 1e-5);
+}
+
+}  // namespace
+}  // namespace ceilpose

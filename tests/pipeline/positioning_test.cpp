@@ -1,0 +1,105 @@
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "pipeline/pipeline_config.h"
+#include "pipeline/positioner.h"
+#include "positioning_support.h"
+
+namespace ceilpose {
+namespace {
+
+TEST(Positioning, AutoUsesLeastSquaresOnAFullView) {
+  PipelineConfig config;
+  Positioner positioner(config);
+  testing::SyntheticView view;
+  const Pose2D robot{2.0, 2.0, 1.0};
+  const PoseEstimate est = positioner.solve(testing::observe(view, robot), PositioningMode::kAuto);
+  ASSERT_TRUE(est.valid);
+  EXPECT_EQ(est.mode, PositioningMode::kLeastSquares);
+  EXPECT_NEAR(est.pose.x_m, robot.x_m, 1e-6);
+}
+
+TEST(Positioning, AutoFallsBackToThesisModeWhenTooFewPoints) {
+  PipelineConfig config;
+  config.positioning.lsq_min_points = 1000;
+  Positioner positioner(config);
+  testing::SyntheticView view;
+  const Pose2D robot{2.0, 2.0, 1.0};
+  auto markers = testing::observe(view, robot);
+  PoseEstimate est = positioner.solve(markers, PositioningMode::kAuto);
+  ASSERT_TRUE(est.valid);
+  EXPECT_EQ(est.mode, PositioningMode::kBarycentric);
+  markers.resize(1);
+  est = positioner.solve(markers, PositioningMode::kAuto);
+  ASSERT_TRUE(est.valid);
+  EXPECT_EQ(est.mode, PositioningMode::kChangeOfAxes);
+  EXPECT_NEAR(est.pose.y_m, robot.y_m, 1e-9);
+}
+
+TEST(Positioning, NoMarkersGivesInvalidPose) {
+  PipelineConfig config;
+  Positioner positioner(config);
+  for (auto mode : {PositioningMode::kAuto, PositioningMode::kChangeOfAxes,
+                    PositioningMode::kBarycentric, PositioningMode::kLeastSquares}) {
+    EXPECT_FALSE(positioner.solve({}, mode).valid);
+  }
+}
+
+TEST(Positioning, OnlyPartialMarkersGivesInvalidPose) {
+  PipelineConfig config;
+  Positioner positioner(config);
+  testing::SyntheticView view;
+  view.include_partial = true;
+  auto markers = testing::observe(view, {2.0, 2.0, 0.3});
+  std::vector<MarkerObservation> partial;
+  for (const auto& m : markers)
+    if (!m.whole) partial.push_back(m);
+  ASSERT_FALSE(partial.empty());
+  EXPECT_FALSE(positioner.solve(partial, PositioningMode::kAuto).valid);
+}
+
+TEST(Positioning, TwoDisagreeingMarkersGiveInvalidPose) {
+  PipelineConfig config;
+  Positioner positioner(config);
+  testing::SyntheticView view;
+  auto markers = testing::observe(view, {2.0, 2.0, 0.3});
+  markers.resize(2);
+  markers[0].code_i ^= 4;
+  EXPECT_FALSE(positioner.solve(markers, PositioningMode::kAuto).valid);
+}
+
+TEST(Positioning, OutlierMarkerDoesNotMoveAnyMode) {
+  PipelineConfig config;
+  Positioner positioner(config);
+  testing::SyntheticView view;
+  const Pose2D robot{2.3, 1.8, -2.0};
+  auto markers = testing::observe(view, robot);
+  ASSERT_GE(markers.size(), 5u);
+  markers[0].code_j ^= 1;
+  markers[4].code_i ^= 3;
+  for (auto mode : {PositioningMode::kAuto, PositioningMode::kChangeOfAxes,
+                    PositioningMode::kBarycentric, PositioningMode::kLeastSquares}) {
+    const PoseEstimate est = positioner.solve(markers, mode);
+    ASSERT_TRUE(est.valid) << to_string(mode);
+    EXPECT_LT(std::hypot(est.pose.x_m - robot.x_m, est.pose.y_m - robot.y_m), 1e-6)
+        << to_string(mode);
+  }
+}
+
+TEST(Positioning, NonFiniteObservationGivesInvalidNotGarbage) {
+  PipelineConfig config;
+  Positioner positioner(config);
+  testing::SyntheticView view;
+  auto markers = testing::observe(view, {2.0, 2.0, 0.3});
+  markers.resize(1);
+  markers[0].red_u_px = NAN;
+  for (auto mode :
+       {PositioningMode::kAuto, PositioningMode::kChangeOfAxes, PositioningMode::kLeastSquares}) {
+    const PoseEstimate est = positioner.solve(markers, mode);
+    EXPECT_FALSE(est.valid) << to_string(mode);
+  }
+}
+
+}  // namespace
+}  // namespace ceilpose

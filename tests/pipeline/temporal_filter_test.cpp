@@ -1,0 +1,138 @@
+#include "pipeline/temporal_filter.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <numbers>
+#include <random>
+
+namespace ceilpose {
+namespace {
+
+constexpr int64_t kFrameNs = 33'333'333;  // 30 fps
+
+PoseEstimate measurement(double x, double y, double yaw, double sigma_m = 0.005) {
+  PoseEstimate m;
+  m.valid = true;
+  m.pose = {x, y, yaw};
+  m.covariance = {sigma_m * sigma_m, 0, 0, 0, sigma_m * sigma_m, 0, 0, 0, 0.01 * 0.01};
+  m.mode = PositioningMode::kLeastSquares;
+  m.markers = 9;
+  return m;
+}
+
+TEST(TemporalFilter, InvalidUntilFirstValidMeasurement) {
+  TemporalFilter filter{FilterParams{}};
+  EXPECT_FALSE(filter.update(PoseEstimate{}, 0).valid);
+  const PoseEstimate out = filter.update(measurement(1.0, 2.0, 0.5), kFrameNs);
+  ASSERT_TRUE(out.valid);
+  EXPECT_DOUBLE_EQ(out.pose.x_m, 1.0);
+  EXPECT_EQ(out.mode, PositioningMode::kLeastSquares);
+}
+
+TEST(TemporalFilter, SmoothsNoiseOfAStationaryRobot) {
+  TemporalFilter filter{FilterParams{}};
+  std::mt19937_64 rng(7);
+  std::normal_distribution<double> noise(0.0, 0.005);
+  double raw_sq = 0.0, filtered_sq = 0.0;
+  int n = 0;
+  for (int k = 0; k < 300; ++k) {
+    const double dx = noise(rng);
+    const PoseEstimate out = filter.update(measurement(1.0 + dx, 2.0, 0.3), k * kFrameNs);
+    ASSERT_TRUE(out.valid);
+    if (k < 30) continue;  // settling
+    raw_sq += dx * dx;
+    filtered_sq += (out.pose.x_m - 1.0) * (out.pose.x_m - 1.0);
+    ++n;
+  }
+  EXPECT_LT(std::sqrt(filtered_sq / n), 0.6 * std::sqrt(raw_sq / n));
+}
+
+TEST(TemporalFilter, TracksConstantVelocityWithoutLag) {
+  TemporalFilter filter{FilterParams{}};
+  PoseEstimate out;
+  for (int k = 0; k < 120; ++k) {
+    const double t = k * kFrameNs * 1e-9;
+    out = filter.update(measurement(0.5 * t, 1.0, 0.0), k * kFrameNs);
+  }
+  const double t_end = 119 * kFrameNs * 1e-9;
+  EXPECT_NEAR(out.pose.x_m, 0.5 * t_end, 0.002);
+}
+
+TEST(TemporalFilter, WrapsYawAcrossPi) {
+  TemporalFilter filter{FilterParams{}};
+  const double pi = std::numbers::pi;
+  filter.update(measurement(1.0, 1.0, pi - 0.01), 0);
+  const PoseEstimate out = filter.update(measurement(1.0, 1.0, -pi + 0.01), kFrameNs);
+  ASSERT_TRUE(out.valid);
+  // Between the two, across ±π — not near 0.
+  EXPECT_GT(std::abs(out.pose.yaw_rad), pi - 0.02);
+  EXPECT_EQ(filter.stats().gated, 0u);
+}
+
+TEST(TemporalFilter, GatesASingleJump) {
+  TemporalFilter filter{FilterParams{}};
+  for (int k = 0; k < 30; ++k) filter.update(measurement(1.0, 1.0, 0.0), k * kFrameNs);
+  const PoseEstimate out = filter.update(measurement(1.6, 1.0, 0.0), 30 * kFrameNs);
+  ASSERT_TRUE(out.valid);
+  EXPECT_NEAR(out.pose.x_m, 1.0, 0.005);
+  EXPECT_EQ(filter.stats().gated, 1u);
+  EXPECT_EQ(out.markers, 0);
+}
+
+TEST(TemporalFilter, ReinitialisesAfterConsecutiveGatedMeasurements) {
+  FilterParams params;
+  params.reinit_after_gated = 4;
+  TemporalFilter filter{params};
+  for (int k = 0; k < 30; ++k) filter.update(measurement(1.0, 1.0, 0.0), k * kFrameNs);
+  PoseEstimate out;
+  for (int k = 30; k < 33; ++k) {
+    out = filter.update(measurement(3.0, 1.0, 0.0), k * kFrameNs);
+    EXPECT_NEAR(out.pose.x_m, 1.0, 0.01);
+  }
+  out = filter.update(measurement(3.0, 1.0, 0.0), 33 * kFrameNs);
+  EXPECT_DOUBLE_EQ(out.pose.x_m, 3.0);
+  EXPECT_EQ(filter.stats().reinitialisations, 1u);
+  EXPECT_EQ(filter.stats().gated, 4u);
+}
+
+TEST(TemporalFilter, PredictsThroughMissingFramesThenTimesOut) {
+  FilterParams params;
+  params.predict_timeout_ms = 200.0;
+  TemporalFilter filter{params};
+  for (int k = 0; k < 60; ++k) {
+    const double t = k * kFrameNs * 1e-9;
+    filter.update(measurement(1.0 + 0.3 * t, 1.0, 0.0), k * kFrameNs);
+  }
+  const double t_last = 59 * kFrameNs * 1e-9;
+  // 100 ms without a pose: still valid, extrapolated along the motion.
+  const int64_t gap_ns = 59 * kFrameNs + 100'000'000;
+  PoseEstimate out = filter.update(PoseEstimate{}, gap_ns);
+  ASSERT_TRUE(out.valid);
+  EXPECT_NEAR(out.pose.x_m, 1.0 + 0.3 * (t_last + 0.1), 0.005);
+  EXPECT_EQ(out.markers, 0);
+  // Past the timeout: invalid, never a stale pose.
+  out = filter.update(PoseEstimate{}, 59 * kFrameNs + 250'000'000);
+  EXPECT_FALSE(out.valid);
+  EXPECT_EQ(filter.stats().timeouts, 1u);
+}
+
+TEST(TemporalFilter, ResetForgetsTheTrack) {
+  TemporalFilter filter{FilterParams{}};
+  filter.update(measurement(1.0, 1.0, 0.0), 0);
+  filter.reset();
+  EXPECT_FALSE(filter.update(PoseEstimate{}, kFrameNs).valid);
+  const PoseEstimate out = filter.update(measurement(4.0, 1.0, 0.0), 2 * kFrameNs);
+  EXPECT_DOUBLE_EQ(out.pose.x_m, 4.0);
+}
+
+TEST(TemporalFilter, CovarianceShrinksAsMeasurementsAccumulate) {
+  TemporalFilter filter{FilterParams{}};
+  const PoseEstimate first = filter.update(measurement(1.0, 1.0, 0.0, 0.01), 0);
+  PoseEstimate out;
+  for (int k = 1; k < 20; ++k) out = filter.update(measurement(1.0, 1.0, 0.0, 0.01), k * kFrameNs);
+  EXPECT_LT(out.covariance[0], first.covariance[0]);
+}
+
+}  // namespace
+}  // namespace ceilpose
