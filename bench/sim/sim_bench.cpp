@@ -1,0 +1,51 @@
+// Renderer speed: one frame per iteration, one thread, for the clean scene
+// and for the combined stress effects, at three resolutions.
+//   ninja -C build sim_bench && build/bench/sim/sim_bench
+#include <benchmark/benchmark.h>
+
+#include "sim/renderer.h"
+#include "sim/scenarios.h"
+
+namespace ceilpose::sim {
+namespace {
+
+SceneOptions options_for(int width_px) {
+  // Same field of view at every resolution: focal length scales with width.
+  SceneOptions o;
+  const double scale = width_px / 640.0;
+  o.intrinsics.width = width_px;
+  o.intrinsics.height = width_px * 3 / 4;
+  o.intrinsics.fx = o.intrinsics.fy = 530.0 * scale;
+  o.intrinsics.cx = 0.5 * (o.intrinsics.width - 1);
+  o.intrinsics.cy = 0.5 * (o.intrinsics.height - 1);
+  return o;
+}
+
+void run(benchmark::State& state, const char* scenario_name) {
+  const SceneOptions options = options_for(static_cast<int>(state.range(0)));
+  Renderer renderer(options);
+  const Result<Scenario> scenario = make_scenario(scenario_name, options, 64, 5);
+  if (!scenario) {
+    state.SkipWithError(scenario.error().message.c_str());
+    return;
+  }
+  Image frame;
+  size_t i = 0;
+  for (auto _ : state) {
+    const ScenarioFrame& f = scenario->frames[i++ % scenario->frames.size()];
+    renderer.render(f.pose, f.mount, f.effects, f.seed, &frame);
+    benchmark::DoNotOptimize(frame.data());
+  }
+  state.SetItemsProcessed(state.iterations());
+}
+
+void BM_RenderClean(benchmark::State& state) { run(state, "random"); }
+void BM_RenderStress(benchmark::State& state) { run(state, "stress"); }
+
+BENCHMARK(BM_RenderClean)->Arg(320)->Arg(640)->Arg(1280)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_RenderStress)->Arg(320)->Arg(640)->Arg(1280)->Unit(benchmark::kMillisecond);
+
+}  // namespace
+}  // namespace ceilpose::sim
+
+BENCHMARK_MAIN();

@@ -1,0 +1,62 @@
+#pragma once
+// Renders the upward camera's view of the SPEC ceiling (tiles, rails, every
+// marker, light fixtures, clutter) for any robot pose and camera mount, with
+// the photometric effects of `Effects`. The simulator is the project's test
+// oracle: its geometry goes through core/camera_model.h so that it shares the
+// conventions of SPEC §3 with the pipeline, and it is anti-aliased by area
+// integration so that sub-pixel accuracy can be measured.
+//
+// Thread: one Renderer per thread (render() uses internal buffers).
+#include <cstdint>
+#include <vector>
+
+#include "core/camera_model.h"
+#include "core/ceiling_layout.h"
+#include "core/image.h"
+#include "core/pose.h"
+#include "sim/ceiling_scene.h"
+#include "sim/effects.h"
+#include "sim/photometry.h"
+
+namespace ceilpose::sim {
+
+struct SceneOptions {
+  CeilingLayout layout;
+  CameraIntrinsics intrinsics;
+  uint64_t seed = 1;  // places fixtures and clutter; seeds the per-frame noise
+};
+
+// Sub-samples per axis of a pixel that straddles an edge.
+inline constexpr int kSupersamplePerAxis = 4;
+
+class Renderer {
+ public:
+  explicit Renderer(const SceneOptions& options);
+
+  // Renders the view of a robot at `robot` with camera `mount` into `out` (RGB24, intrinsics size).
+  // Deterministic in (options.seed, frame_seed). Allocates only when out's size changes.
+  void render(const Pose2D& robot, const CameraMount& mount, const Effects& effects,
+              uint64_t frame_seed, Image* out);
+
+  // The ceiling point (x, y) that pixel (u, v) sees, through the same ray
+  // mapping render() uses. False when the ray does not reach the ceiling.
+  bool ceiling_point(const Pose2D& robot, const CameraMount& mount, double u_px, double v_px,
+                     double* x_m, double* y_m) const;
+
+  const SceneOptions& options() const { return options_; }
+  const CeilingScene& scene() const { return scene_; }
+
+ private:
+  SceneOptions options_;
+  CeilingScene scene_;
+  // Undistorted normalized coordinates (x, y) of every pixel corner,
+  // (width+1) x (height+1), computed once: the distortion model is inverted
+  // here and never per frame.
+  std::vector<float> corner_xy_;
+  std::vector<float> linear_;       // integrated radiance, width*height*3
+  std::vector<uint8_t> row_above_;  // materials at the corners above the current pixel row
+  std::vector<uint8_t> row_below_;
+  Photometry photometry_;
+};
+
+}  // namespace ceilpose::sim
