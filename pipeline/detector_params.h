@@ -1,10 +1,87 @@
 #pragma once
 // Parameters of the detection stages (colour classification .. dot reading).
-// Owned by the detection stages; every field: meaning, unit, cost, when to tune.
+// One struct, defaults in one place; config/ceilpose.yaml mirrors them.
+// Colour thresholds apply to *normalised* pixels: each frame is first scaled
+// per channel so that its ceiling tile reads as the nominal tile colour of
+// SPEC §2 (≈ 215, 215, 205), which makes them independent of exposure and
+// white balance (see color_classifier.cpp).
 namespace ceilpose {
 
 struct DetectorParams {
+  // --- colour classification (color_classifier.cpp) ---
+  // A normalised pixel whose brightest channel is below this is "dark" (a
+  // dot). Dots print at 25, the red and green rectangles at 200 and 160: the
+  // default sits near the green/dot midpoint. Raise it if blurred dots read
+  // as unset; lower it if shadows on rectangles split them. Cost: none.
+  int dark_max_value = 90;
+  // Minimum HSV saturation (max-min)/max of a red / green pixel. Pixels
+  // below are tile, rails or fixtures. The defaults cut a red/tile and a
+  // green/tile edge pixel at about the same coverage (≈ 40 % if the edge was
+  // mixed in sRGB, ≈ 60 % if in linear light), so that both rectangles shrink
+  // alike and the marker centre stays unbiased. Raise under strong coloured
+  // light. Cost: none.
+  float red_min_saturation = 0.33f;
+  float green_min_saturation = 0.24f;
+  // Red versus green is decided by r - g (normalised levels) against this
+  // split: r - g is linear in the mix, so a pixel on the shared edge goes to
+  // the rectangle that covers more of it. Cost: none.
+  int red_green_split = 25;
+  // Hue windows (degrees) that a saturated pixel must fall in to be red or
+  // green; everything else saturated (blue, yellow clutter) is background.
+  float red_hue_min_deg = -60.0f;  // i.e. 300°
+  float red_hue_max_deg = 60.0f;
+  float green_hue_min_deg = 25.0f;
+  float green_hue_max_deg = 190.0f;
+  // Grid step, in pixels, of the sparse sample that estimates the frame's
+  // tile (white) reference. Smaller is steadier and costs more (about
+  // width*height/step² pixel reads).
+  int white_sample_step_px = 8;
+  // Share of the sampled pixels that must look like tile for the estimate to
+  // be trusted; otherwise the previous frame's reference is kept (counted).
+  float white_min_share = 0.05f;
+
+  // --- connected components (components.cpp) ---
+  // Upper bound of runs per frame as a share of the pixel count. A frame
+  // with more (random noise) is abandoned: no markers, counted. Memory:
+  // about 40 bytes per run, allocated once.
+  float max_runs_per_pixel = 0.125f;
+
+  // --- rectangle template fit (rectangle_fit.cpp) ---
   int min_rect_area_px = 150;  // smallest rectangle blob accepted, pixels
+  // Accepted area as a fraction of the area the camera model predicts for a
+  // rectangle (5 × 12 in seen from the nominal height). Widen for ceilings
+  // of uneven height or strong tilt.
+  float area_min_ratio = 0.55f;
+  float area_max_ratio = 1.6f;
+  // Accepted short/long side ratio (nominal 5/12 ≈ 0.417), from the blob's
+  // second moments.
+  float aspect_min = 0.28f;
+  float aspect_max = 0.58f;
+  // Accepted area / (long × short side from the moments): 1 for a filled
+  // rectangle, lower for L-shapes and rings, higher for diamonds.
+  float fill_min = 0.85f;
+  float fill_max = 1.12f;
+
+  // --- pairing red with green (marker_pairing.cpp) ---
+  // Relative tolerance on the red–green centre distance (nominal: the
+  // rectangle width, 5 in) and on the area ratio of the two rectangles.
+  float pair_distance_tolerance = 0.3f;
+  float pair_area_tolerance = 0.45f;
+  // Largest angle (rad) between the two long axes, and between the
+  // red→green vector and the normal of the red long axis.
+  float pair_angle_tolerance_rad = 0.25f;
+
+  // --- dot reading (dot_reader.cpp) ---
+  // A slot holds a dot when its brightness is below this fraction of the
+  // rectangle's own brightness (dot ≈ 0.13–0.16 of it when sharp, up to
+  // ≈ 0.55 for a red dot under 1 px defocus plus 3 px motion blur; an empty
+  // slot reads ≈ 1).
+  float dot_threshold_ratio = 0.72f;
+  // How far either side of its slot, along North (metres on the ceiling), a
+  // dot's darkest line is searched. Covers centroid shifts from glare or
+  // partial occlusion; must stay below pitch − dot height (2 in by default).
+  // Cost: one line of three samples per pixel searched.
+  double dot_search_m = 0.0254;
 };
 
 }  // namespace ceilpose

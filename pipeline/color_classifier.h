@@ -1,0 +1,98 @@
+#pragma once
+// Stage 1a: colour classification of pixels into red / green / dark /
+// background through one fused lookup, with thresholds that follow the
+// frame's exposure and white balance. Single-threaded: one instance per
+// pipeline, called from the processing thread only.
+#include <algorithm>
+#include <array>
+#include <cstdint>
+#include <vector>
+
+#include "core/ceiling_layout.h"
+#include "core/image.h"
+#include "pipeline/detector_params.h"
+
+namespace ceilpose {
+
+enum class PixelClass : uint8_t { kBackground = 0, kRed = 1, kGreen = 2, kDark = 3 };
+
+// BT.601 limited range (V4L2's default quantisation for YUYV) to RGB, integer.
+inline void yuv_to_rgb(int y, int u, int v, uint8_t* r, uint8_t* g, uint8_t* b) {
+  const int c = 298 * (y - 16) + 128;
+  const int d = u - 128, e = v - 128;
+  *r = static_cast<uint8_t>(std::clamp((c + 409 * e) >> 8, 0, 255));
+  *g = static_cast<uint8_t>(std::clamp((c - 100 * d - 208 * e) >> 8, 0, 255));
+  *b = static_cast<uint8_t>(std::clamp((c + 516 * d) >> 8, 0, 255));
+}
+
+// RGB of pixel (x, y) in any uncompressed format; grey gives r = g = b.
+// For sparse reads only (white sample, dot slots), not for full-frame sweeps.
+inline void read_rgb(const ImageView& f, int x, int y, uint8_t* r, uint8_t* g, uint8_t* b) {
+  const uint8_t* p = f.row(y);
+  switch (f.format) {
+    case PixelFormat::kRgb24:
+      *r = p[3 * x], *g = p[3 * x + 1], *b = p[3 * x + 2];
+      return;
+    case PixelFormat::kBgr24:
+      *b = p[3 * x], *g = p[3 * x + 1], *r = p[3 * x + 2];
+      return;
+    case PixelFormat::kYuyv: {
+      const uint8_t* q = p + 4 * (x / 2);
+      yuv_to_rgb(q[(x & 1) * 2], q[1], q[3], r, g, b);
+      return;
+    }
+    case PixelFormat::kGray8:
+      *r = *g = *b = p[x];
+      return;
+    case PixelFormat::kMjpeg:
+      break;
+  }
+  *r = *g = *b = 0;
+}
+
+class ColorClassifier {
+ public:
+  static constexpr int kBitsPerChannel = 6;
+  static constexpr int kCells = 1 << kBitsPerChannel;
+
+  // Builds the lookup table (≈ 10 ms, 256 KiB). `tile` is the nominal tile
+  // colour the frame is normalised to.
+  ColorClassifier(const DetectorParams& params, Rgb tile);
+
+  // Rebuilds the table for new thresholds (SIGHUP reload); not per frame.
+  void set_params(const DetectorParams& params, Rgb tile);
+
+  // Estimates the frame's tile reference from a sparse grid sample and sets
+  // the per-channel normalisation. Returns false when too few pixels looked
+  // like tile; the previous normalisation is then kept.
+  bool adapt(const ImageView& frame);
+
+  // Normalisation tables: table(c)[level] is the channel's normalised,
+  // quantised level already shifted into its place in the lookup index, so
+  // that class = lut()[table(0)[r] | table(1)[g] | table(2)[b]].
+  const uint32_t* table(int channel) const { return tables_[channel].data(); }
+  const uint8_t* lut() const { return lut_.data(); }
+
+  PixelClass classify(uint8_t r, uint8_t g, uint8_t b) const {
+    return static_cast<PixelClass>(lut_[tables_[0][r] | tables_[1][g] | tables_[2][b]]);
+  }
+  // Classification of a pixel already in normalised levels (for tests and
+  // for building the table).
+  PixelClass classify_normalised(int r, int g, int b) const;
+
+  // Current per-channel gains (normalised = raw × gain) and the measured
+  // tile reference (raw levels) they came from.
+  const std::array<float, 3>& gains() const { return gains_; }
+  const std::array<float, 3>& reference() const { return reference_; }
+  void set_gains(const std::array<float, 3>& gains);
+
+ private:
+  DetectorParams params_;
+  Rgb tile_{};
+  std::vector<uint8_t> lut_;
+  std::array<std::array<uint32_t, 256>, 3> tables_{};
+  std::array<float, 3> gains_{1.0f, 1.0f, 1.0f};
+  std::array<float, 3> reference_{};
+};
+
+}  // namespace ceilpose

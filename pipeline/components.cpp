@@ -1,0 +1,245 @@
+#include "pipeline/components.h"
+
+#include <cmath>
+#include <cstring>
+
+// One sweep, row by row (issue 3, "runs → components in the same sweep"):
+//   a. classify the row into a byte buffer through the fused lookup (one
+//      table lookup per pixel, no colour-space conversion pass);
+//   b. run-length encode it, skipping background eight bytes at a time; a
+//      dark run that sits between two runs of the same colour (a dot inside
+//      its rectangle) is folded into one run of that colour, counting its
+//      pixels as dark; other dark runs (shadows, occluders) are dropped;
+//   c. unite each run with the runs of the same colour in the previous row
+//      that touch it, diagonals included (8-connectivity): run a on row y−1
+//      and b on row y touch when a.x0 ≤ b.x1 + 1 and a.x1 ≥ b.x0 − 1.
+// Union-find always links the larger root under the smaller, so every set's
+// root is its first run; one pass in run order then numbers the components
+// and sums each run's moments in closed form (Σx over x0..x1 and Σx²).
+// Because a dot is always enclosed left and right by its rectangle (SPEC §2:
+// margins of 1 in or more), its rows fold completely, and the rectangle's
+// centroid is that of the full rectangle whatever its code.
+
+namespace ceilpose {
+namespace {
+
+constexpr size_t kRowPadding = 8;
+
+int64_t sum_squares_to(int64_t k) { return k * (k + 1) * (2 * k + 1) / 6; }
+
+}  // namespace
+
+double Component::orientation_rad() const { return 0.5 * std::atan2(2.0 * mu11, mu20 - mu02); }
+
+ComponentLabeler::ComponentLabeler(int width_px, int height_px, const DetectorParams& params)
+    : params_(params) {
+  resize(width_px, height_px);
+}
+
+void ComponentLabeler::resize(int width_px, int height_px) {
+  width_ = std::max(0, width_px);
+  height_ = std::max(0, height_px);
+  const double pixels = static_cast<double>(width_) * height_;
+  max_runs_ = std::max(1024, static_cast<int>(pixels * params_.max_runs_per_pixel));
+  row_class_.assign(static_cast<size_t>(width_) + kRowPadding, 0);
+  runs_.resize(static_cast<size_t>(max_runs_) + 1);
+  parent_.resize(runs_.size());
+  label_.resize(runs_.size());
+  comps_.resize(runs_.size());
+  sums_.resize(runs_.size());
+  run_count_ = 0;
+  comp_count_ = 0;
+}
+
+void ComponentLabeler::classify_row(const ImageView& frame, int y,
+                                    const ColorClassifier& classifier) {
+  const uint8_t* p = frame.row(y);
+  uint8_t* out = row_class_.data();
+  const uint8_t* lut = classifier.lut();
+  const int w = width_;
+  switch (frame.format) {
+    case PixelFormat::kRgb24:
+    case PixelFormat::kBgr24: {
+      const bool rgb = frame.format == PixelFormat::kRgb24;
+      const uint32_t* t0 = classifier.table(rgb ? 0 : 2);
+      const uint32_t* t1 = classifier.table(1);
+      const uint32_t* t2 = classifier.table(rgb ? 2 : 0);
+      for (int x = 0; x < w; ++x, p += 3) out[x] = lut[t0[p[0]] | t1[p[1]] | t2[p[2]]];
+      return;
+    }
+    case PixelFormat::kYuyv: {
+      const uint32_t* tr = classifier.table(0);
+      const uint32_t* tg = classifier.table(1);
+      const uint32_t* tb = classifier.table(2);
+      uint8_t r = 0, g = 0, b = 0;
+      int x = 0;
+      for (; x + 1 < w; x += 2, p += 4) {
+        yuv_to_rgb(p[0], p[1], p[3], &r, &g, &b);
+        out[x] = lut[tr[r] | tg[g] | tb[b]];
+        yuv_to_rgb(p[2], p[1], p[3], &r, &g, &b);
+        out[x + 1] = lut[tr[r] | tg[g] | tb[b]];
+      }
+      if (x < w) {
+        yuv_to_rgb(p[0], p[1], p[3], &r, &g, &b);
+        out[x] = lut[tr[r] | tg[g] | tb[b]];
+      }
+      return;
+    }
+    case PixelFormat::kGray8:
+    case PixelFormat::kMjpeg:
+      std::memset(out, 0, static_cast<size_t>(w));
+      return;
+  }
+}
+
+bool ComponentLabeler::encode_row(int y) {
+  const uint8_t* c = row_class_.data();
+  const int w = width_;
+  const int row_begin = run_count_;
+  constexpr auto kDark = static_cast<uint8_t>(PixelClass::kDark);
+  int x = 0;
+  while (x < w) {
+    uint64_t word = 0;
+    std::memcpy(&word, c + x, sizeof word);
+    if (word == 0) {  // the padding after the row is zero, so this may look past w
+      x += 8;
+      continue;
+    }
+    while (c[x] == 0) ++x;
+    if (x >= w) break;
+    const uint8_t cls = c[x];
+    const int x0 = x;
+    while (c[x] == cls) ++x;  // stops at the zero padding at the latest
+    const int x1 = x - 1;
+    const int in_row = run_count_ - row_begin;
+    if (cls == kDark) {
+      // Keep a dark run only while it may still be enclosed: it must start
+      // right after a coloured run.
+      if (in_row > 0 && runs_[run_count_ - 1].x1 + 1 == x0) {
+        if (run_count_ >= max_runs_) return false;
+        runs_[run_count_++] = Run{x0, x1, y, 0, PixelClass::kDark};
+      }
+      continue;
+    }
+    if (in_row > 0 && runs_[run_count_ - 1].cls == PixelClass::kDark) {
+      const Run dark = runs_[run_count_ - 1];
+      --run_count_;
+      Run& left = runs_[run_count_ - 1];
+      if (dark.x1 + 1 == x0 && static_cast<uint8_t>(left.cls) == cls) {
+        left.dark_px += dark.x1 - dark.x0 + 1;
+        left.x1 = x1;
+        continue;
+      }
+    }
+    if (run_count_ >= max_runs_) return false;
+    runs_[run_count_] = Run{x0, x1, y, 0, static_cast<PixelClass>(cls)};
+    parent_[run_count_] = run_count_;
+    ++run_count_;
+  }
+  if (run_count_ > row_begin && runs_[run_count_ - 1].cls == PixelClass::kDark) --run_count_;
+  return true;
+}
+
+int32_t ComponentLabeler::find(int32_t i) {
+  while (parent_[i] != i) {
+    parent_[i] = parent_[parent_[i]];
+    i = parent_[i];
+  }
+  return i;
+}
+
+void ComponentLabeler::unite(int32_t a, int32_t b) {
+  const int32_t ra = find(a), rb = find(b);
+  if (ra == rb) return;
+  if (ra < rb) {
+    parent_[rb] = ra;
+  } else {
+    parent_[ra] = rb;
+  }
+}
+
+void ComponentLabeler::join_rows(int prev_begin, int prev_end, int cur_begin, int cur_end) {
+  int p = prev_begin;
+  for (int i = cur_begin; i < cur_end; ++i) {
+    const Run& cur = runs_[i];
+    while (p < prev_end && runs_[p].x1 + 1 < cur.x0) ++p;
+    for (int q = p; q < prev_end && runs_[q].x0 <= cur.x1 + 1; ++q) {
+      if (runs_[q].cls == cur.cls) unite(q, i);
+    }
+  }
+}
+
+void ComponentLabeler::accumulate() {
+  comp_count_ = 0;
+  for (int i = 0; i < run_count_; ++i) {
+    const Run& run = runs_[i];
+    const int32_t root = find(i);
+    int32_t k = 0;
+    if (root == i) {
+      k = static_cast<int32_t>(comp_count_++);
+      Component& c = comps_[k];
+      c = Component{};
+      c.cls = run.cls;
+      c.x_min = run.x0;
+      c.x_max = run.x1;
+      c.y_min = c.y_max = run.y;
+      sums_[k] = {};
+    } else {
+      k = label_[root];
+    }
+    label_[i] = k;
+    Component& c = comps_[k];
+    const int64_t n = run.x1 - run.x0 + 1;
+    const double sx = 0.5 * static_cast<double>(run.x0 + run.x1) * static_cast<double>(n);
+    const double sxx = static_cast<double>(sum_squares_to(run.x1) - sum_squares_to(run.x0 - 1));
+    const double y = run.y;
+    auto& s = sums_[k];
+    s[0] += sx;
+    s[1] += y * static_cast<double>(n);
+    s[2] += sxx;
+    s[3] += y * sx;
+    s[4] += y * y * static_cast<double>(n);
+    c.area_px += static_cast<int>(n);
+    c.dark_px += run.dark_px;
+    c.x_min = std::min(c.x_min, run.x0);
+    c.x_max = std::max(c.x_max, run.x1);
+    c.y_min = std::min(c.y_min, run.y);
+    c.y_max = std::max(c.y_max, run.y);
+  }
+  for (size_t k = 0; k < comp_count_; ++k) {
+    Component& c = comps_[k];
+    const auto& s = sums_[k];
+    const double a = c.area_px;
+    c.cx = s[0] / a;
+    c.cy = s[1] / a;
+    c.mu20 = s[2] / a - c.cx * c.cx;
+    c.mu11 = s[3] / a - c.cx * c.cy;
+    c.mu02 = s[4] / a - c.cy * c.cy;
+    c.touches_border =
+        c.x_min == 0 || c.y_min == 0 || c.x_max == width_ - 1 || c.y_max == height_ - 1;
+  }
+}
+
+bool ComponentLabeler::label(const ImageView& frame, const ColorClassifier& classifier) {
+  run_count_ = 0;
+  comp_count_ = 0;
+  if (frame.width != width_ || frame.height != height_ || frame.empty()) return false;
+  // Grey frames carry no colour: nothing can be red or green.
+  if (frame.format == PixelFormat::kGray8 || frame.format == PixelFormat::kMjpeg) return true;
+  int prev_begin = 0, prev_end = 0;
+  for (int y = 0; y < height_; ++y) {
+    classify_row(frame, y, classifier);
+    const int cur_begin = run_count_;
+    if (!encode_row(y)) {
+      run_count_ = 0;
+      return false;
+    }
+    join_rows(prev_begin, prev_end, cur_begin, run_count_);
+    prev_begin = cur_begin;
+    prev_end = run_count_;
+  }
+  accumulate();
+  return true;
+}
+
+}  // namespace ceilpose

@@ -1,0 +1,82 @@
+#pragma once
+// Stage 1: one sweep over the frame that classifies every pixel (fused
+// lookup of color_classifier.h), run-length encodes each row and joins runs
+// into 8-connected components with union-find, accumulating area, centroid
+// and second central moments per component. Dark pixels enclosed left and
+// right by one colour (the dots) count towards that colour's component, so a
+// rectangle's moments are those of the whole rectangle, whatever its code.
+// Allocates only in the constructor and resize(); one instance per pipeline.
+#include <array>
+#include <cstdint>
+#include <span>
+#include <vector>
+
+#include "core/image.h"
+#include "pipeline/color_classifier.h"
+#include "pipeline/detector_params.h"
+
+namespace ceilpose {
+
+struct Component {
+  PixelClass cls = PixelClass::kBackground;
+  int area_px = 0;  // pixels, dots included
+  int dark_px = 0;  // enclosed dark pixels among area_px
+  int x_min = 0, x_max = 0, y_min = 0, y_max = 0;
+  bool touches_border = false;  // some pixel lies on the outermost row/column
+  // Centroid (pixel centres at integer coordinates, SPEC §3) and second
+  // central moments per pixel: mu20 = E[(x−cx)²], mu11, mu02.
+  double cx = 0.0, cy = 0.0;
+  double mu20 = 0.0, mu11 = 0.0, mu02 = 0.0;
+
+  // Orientation of the major axis from tan 2θ = 2·mu11 / (mu20 − mu02),
+  // radians in (−π/2, π/2], image axes (u right, v down).
+  double orientation_rad() const;
+};
+
+class ComponentLabeler {
+ public:
+  ComponentLabeler(int width_px, int height_px, const DetectorParams& params);
+
+  // Re-allocates for another frame size (only when the size changes).
+  void resize(int width_px, int height_px);
+  int width_px() const { return width_; }
+  int height_px() const { return height_; }
+
+  // Labels one frame, which must have the size given at construction.
+  // Returns false (and no components) when the frame exceeded the run
+  // budget (`max_runs_per_pixel`): noise, not a ceiling. GRAY8 frames hold
+  // no colour and give no components. Hot path: no allocation.
+  bool label(const ImageView& frame, const ColorClassifier& classifier);
+
+  std::span<const Component> components() const { return {comps_.data(), comp_count_}; }
+  int run_count() const { return run_count_; }
+
+ private:
+  struct Run {
+    int32_t x0, x1, y;
+    int32_t dark_px;
+    PixelClass cls;
+  };
+
+  void classify_row(const ImageView& frame, int y, const ColorClassifier& classifier);
+  bool encode_row(int y);
+  void join_rows(int prev_begin, int prev_end, int cur_begin, int cur_end);
+  int32_t find(int32_t i);
+  void unite(int32_t a, int32_t b);
+  void accumulate();
+
+  DetectorParams params_;
+  int width_ = 0;
+  int height_ = 0;
+  int max_runs_ = 0;
+  std::vector<uint8_t> row_class_;  // width + 8 bytes of padding
+  std::vector<Run> runs_;
+  std::vector<int32_t> parent_;
+  std::vector<int32_t> label_;
+  std::vector<Component> comps_;
+  std::vector<std::array<double, 5>> sums_;  // Σx, Σy, Σx², Σxy, Σy² per component
+  int run_count_ = 0;
+  size_t comp_count_ = 0;
+};
+
+}  // namespace ceilpose

@@ -1,0 +1,143 @@
+#include "pipeline/dot_reader.h"
+
+#include <algorithm>
+#include <bit>
+#include <cmath>
+#include <numbers>
+
+#include "pipeline/color_classifier.h"
+
+// Heading (SPEC §2–3). The red→green vector is the marker's West. Looking
+// up, the image is the ceiling seen from below, so with West at image
+// direction (a, b) North is at (b, −a) and East at (−a, −b): at yaw 0, West
+// is image down (0, 1) and North image right (1, 0), as SPEC §3's camera axes
+// give. The scale comes from the long sides (12 in), which thresholding
+// shortens least in relative terms.
+//
+// Read_Dots. A slot holds a dot when the brightness (max of R, G, B) at the
+// slot, averaged bilinearly over a 3 × 3 grid on the dot's core, falls
+// below `dot_threshold_ratio` of the rectangle's own brightness, measured the
+// same way half-way between slots where no dot is ever printed. A ratio of
+// two readings of the same frame is independent of exposure; a printed dot
+// reads ≈ 0.13–0.16 of its rectangle when sharp, and ≈ 0.5 only under blur
+// that would also hide the marker.
+
+namespace ceilpose {
+namespace {
+
+// Brightness (max of R, G, B) at an image point, bilinear between pixels.
+// Returns −1 outside the frame.
+double brightness_at(const ImageView& frame, double u, double v) {
+  const int x0 = static_cast<int>(std::floor(u)), y0 = static_cast<int>(std::floor(v));
+  if (x0 < 0 || y0 < 0 || x0 + 1 >= frame.width || y0 + 1 >= frame.height) return -1.0;
+  const double fu = u - x0, fv = v - y0;
+  double level[4];
+  for (int k = 0; k < 4; ++k) {
+    uint8_t r = 0, g = 0, b = 0;
+    read_rgb(frame, x0 + (k & 1), y0 + (k >> 1), &r, &g, &b);
+    level[k] = std::max({r, g, b});
+  }
+  return (1 - fv) * ((1 - fu) * level[0] + fu * level[1]) +
+         fv * ((1 - fu) * level[2] + fu * level[3]);
+}
+
+// Mean brightness over a 3 × 3 grid of points around marker point (e, n),
+// spread ±(spread_e_m, spread_n_m). Returns −1 when a point is outside.
+double patch_brightness(const ImageView& frame, const MarkerFrame& m, double e_m, double n_m,
+                        double spread_e_m, double spread_n_m) {
+  double sum = 0.0;
+  for (int ie = -1; ie <= 1; ++ie) {
+    for (int in = -1; in <= 1; ++in) {
+      double u = 0.0, v = 0.0;
+      m.project(e_m + ie * spread_e_m, n_m + in * spread_n_m, &u, &v);
+      const double b = brightness_at(frame, u, v);
+      if (b < 0.0) return -1.0;
+      sum += b;
+    }
+  }
+  return sum / 9.0;
+}
+
+}  // namespace
+
+MarkerFrame marker_frame(const RectangleCandidate& red, const RectangleCandidate& green,
+                         const CeilingLayout& layout) {
+  MarkerFrame m;
+  m.centre_u_px = 0.5 * (red.cx + green.cx);
+  m.centre_v_px = 0.5 * (red.cy + green.cy);
+  const double du = green.cx - red.cx, dv = green.cy - red.cy;
+  const double dist = std::hypot(du, dv);
+  m.west_image_rad = std::atan2(dv, du);
+  const double a = dist > 0.0 ? du / dist : 1.0, b = dist > 0.0 ? dv / dist : 0.0;
+  const double px_per_m = 0.5 * (red.long_px + green.long_px) / layout.rect_height_m;
+  m.east_u = -a * px_per_m;
+  m.east_v = -b * px_per_m;
+  m.north_u = b * px_per_m;
+  m.north_v = -a * px_per_m;
+  return m;
+}
+
+CodeReading read_code(const ImageView& frame, const MarkerFrame& marker, bool red,
+                      const CeilingLayout& layout, const DetectorParams& params) {
+  CodeReading out;
+  const double e_m = red ? layout.red_centre_e_m() : layout.green_centre_e_m();
+  const double dot_e_m = red ? layout.red_dot_e_m : layout.green_dot_e_m;
+  const double dot_n_m = red ? layout.red_dot_n_m : layout.green_dot_n_m;
+  // Reference: half-way between slots (and beyond the end slots while that
+  // stays 1 in inside the rectangle).
+  const double limit_n_m = 0.5 * layout.rect_height_m - kInch_m;
+  double ref_sum = 0.0;
+  int ref_count = 0;
+  for (int k = 0; k <= layout.bits; ++k) {
+    const double n_m = layout.slot_n_m(0) + 0.5 * layout.slot_pitch_m - k * layout.slot_pitch_m;
+    if (std::abs(n_m) > limit_n_m) continue;
+    const double b =
+        patch_brightness(frame, marker, e_m, n_m, 0.25 * layout.rect_width_m, 0.1 * dot_n_m);
+    if (b < 0.0) return out;
+    ref_sum += b;
+    ++ref_count;
+  }
+  if (ref_count == 0) return out;
+  const double reference = ref_sum / ref_count;
+  if (reference < 1.0) return out;
+  const double px_per_m = std::hypot(marker.north_u, marker.north_v);
+  const double step_m = px_per_m > 0.0 ? 1.0 / px_per_m : params.dot_search_m;
+  const int search_steps = std::clamp(static_cast<int>(params.dot_search_m / step_m), 0, 32);
+  int code = 0;
+  double margin = 1.0;
+  for (int k = 0; k < layout.bits; ++k) {
+    // The dot's darkest line: lines across the slot (three points, a
+    // quarter of the dot's width apart) one pixel apart over ±dot_search_m
+    // along North; the darkest is the dot's core wherever blur, a rectangle
+    // eaten by glare or a slightly wrong scale put it. The search stays
+    // clear of the neighbouring slots' dots (pitch 4 in).
+    double b = -1.0;
+    for (int step = -search_steps; step <= search_steps; ++step) {
+      const double line = patch_brightness(frame, marker, e_m, layout.slot_n_m(k) + step * step_m,
+                                           0.25 * dot_e_m, 0.0);
+      if (line < 0.0) return out;
+      b = b < 0.0 ? line : std::min(b, line);
+    }
+    const double ratio = b / reference;
+    out.ratio[k] = static_cast<float>(ratio);
+    if (ratio < params.dot_threshold_ratio) code |= 1 << (layout.bits - 1 - k);
+    margin = std::min(margin, std::abs(ratio - params.dot_threshold_ratio));
+  }
+  out.ok = true;
+  out.code = code;
+  out.margin = static_cast<float>(margin);
+  return out;
+}
+
+bool dark_area_consistent(const RectangleCandidate& rect, int code, bool red,
+                          const CeilingLayout& layout, double px_per_m) {
+  const double dot_area_px =
+      0.25 * std::numbers::pi * px_per_m * px_per_m *
+      (red ? layout.red_dot_e_m * layout.red_dot_n_m : layout.green_dot_e_m * layout.green_dot_n_m);
+  const int dots = std::popcount(static_cast<unsigned>(code));
+  // Blur and the dark threshold shrink dots, never grow them much: allow the
+  // code's dots, most of one more, and 2 % of the rectangle for noise.
+  return rect.dark_px <= (dots + 0.75) * dot_area_px + 0.02 * rect.area_px;
+}
+
+}  // namespace ceilpose

@@ -1,0 +1,49 @@
+#pragma once
+// Stage 4: the marker's frame in the image (Heading) and its code (Read_Dots).
+// The red→green vector is West; North follows from it; the dots are read
+// slot by slot, most significant bit northernmost (SPEC §2).
+#include <array>
+
+#include "core/ceiling_layout.h"
+#include "core/image.h"
+#include "pipeline/detector_params.h"
+#include "pipeline/rectangle_fit.h"
+
+namespace ceilpose {
+
+// Affine image frame of one marker: marker point (e, n) in metres lands at
+// (centre_u + e·east_u + n·north_u, centre_v + e·east_v + n·north_v).
+struct MarkerFrame {
+  double centre_u_px = 0.0, centre_v_px = 0.0;
+  double east_u = 0.0, east_v = 0.0;    // pixels per metre East
+  double north_u = 0.0, north_v = 0.0;  // pixels per metre North
+  double west_image_rad = 0.0;          // atan2 of the red→green vector
+
+  void project(double e_m, double n_m, double* u_px, double* v_px) const {
+    *u_px = centre_u_px + e_m * east_u + n_m * north_u;
+    *v_px = centre_v_px + e_m * east_v + n_m * north_v;
+  }
+};
+
+MarkerFrame marker_frame(const RectangleCandidate& red, const RectangleCandidate& green,
+                         const CeilingLayout& layout);
+
+struct CodeReading {
+  bool ok = false;                      // every sample inside the frame and a usable reference
+  int code = 0;                         // 0 .. 2^bits − 1
+  float margin = 0.0f;                  // smallest distance of a slot's ratio to the threshold
+  std::array<float, kMaxBits> ratio{};  // slot brightness / rectangle brightness, MSB first
+};
+
+// Reads the `layout.bits` slots of the red (x code) or green (y code)
+// rectangle. Sparse reads of the original frame: no allocation.
+CodeReading read_code(const ImageView& frame, const MarkerFrame& marker, bool red,
+                      const CeilingLayout& layout, const DetectorParams& params);
+
+// Whether the dark pixels found inside a rectangle fit the dots its code
+// says it has: more dark area than the dots plus slack means dirt, an
+// occluder or a foreign pattern, not a marker.
+bool dark_area_consistent(const RectangleCandidate& rect, int code, bool red,
+                          const CeilingLayout& layout, double px_per_m);
+
+}  // namespace ceilpose

@@ -1,0 +1,186 @@
+#include "pipeline/pipeline.h"
+
+#include <algorithm>
+#include <stdexcept>
+#include <string>
+
+#include "core/clock.h"
+#include "pipeline/dot_reader.h"
+
+namespace ceilpose {
+namespace {
+
+// Rectangles kept per frame: 9–12 markers give ~24; the rest is headroom
+// for clutter.
+constexpr int kMaxRectangles = 256;
+
+void check_size(const CameraIntrinsics& k) {
+  if (k.width <= 0 || k.height <= 0) {
+    throw std::invalid_argument("pipeline: camera.width and camera.height must be positive, got " +
+                                std::to_string(k.width) + "x" + std::to_string(k.height));
+  }
+}
+
+}  // namespace
+
+Pipeline::Pipeline(const PipelineConfig& config)
+    : config_(config),
+      classifier_(config.detector, config.layout.tile),
+      labeler_(config.intrinsics.width, config.intrinsics.height, config.detector),
+      model_(make_rectangle_model(config.intrinsics, config.mount, config.layout)),
+      rects_(kMaxRectangles),
+      pairer_(kMaxRectangles),
+      pairs_(kMaxMarkersPerFrame),
+      positioner_(config) {
+  check_size(config.intrinsics);
+}
+
+void Pipeline::set_config(const PipelineConfig& config) {
+  check_size(config.intrinsics);
+  config_ = config;
+  classifier_.set_params(config.detector, config.layout.tile);
+  // The run budget depends on the parameters as well as on the size.
+  labeler_ = ComponentLabeler(config.intrinsics.width, config.intrinsics.height, config.detector);
+  model_ = make_rectangle_model(config.intrinsics, config.mount, config.layout);
+  positioner_ = Positioner(config);
+}
+
+const char* Pipeline::stage_name(int stage) {
+  switch (stage) {
+    case kStageComponents:
+      return "components";
+    case kStageRectangles:
+      return "rectangles";
+    case kStagePairing:
+      return "pairing";
+    case kStageDecoding:
+      return "decoding";
+    case kStagePositioning:
+      return "positioning";
+    default:
+      return "unknown";
+  }
+}
+
+bool Pipeline::usable(const ImageView& frame) const {
+  if (frame.empty() || frame.format == PixelFormat::kMjpeg) return false;
+  if (frame.width != config_.intrinsics.width || frame.height != config_.intrinsics.height)
+    return false;
+  const size_t row_bytes = static_cast<size_t>(frame.width) * bytes_per_pixel(frame.format);
+  if (frame.stride_bytes < 0 || static_cast<size_t>(frame.stride_bytes) < row_bytes) return false;
+  const size_t needed = static_cast<size_t>(frame.stride_bytes) * (frame.height - 1) + row_bytes;
+  return frame.size_bytes == 0 || frame.size_bytes >= needed;
+}
+
+bool Pipeline::decode(const ImageView& frame, const MarkerPair& pair, MarkerObservation* out) {
+  const RectangleCandidate& red = rects_[pair.red];
+  const RectangleCandidate& green = rects_[pair.green];
+  // A rectangle cut by the frame border has a shifted centroid, which puts
+  // the slots off the dots: such a marker could only be misread.
+  if (red.touches_border || green.touches_border) {
+    ++counters_.cut_markers;
+    return false;
+  }
+  const CeilingLayout& layout = config_.layout;
+  const MarkerFrame m = marker_frame(red, green, layout);
+  const CodeReading code_i = read_code(frame, m, true, layout, config_.detector);
+  const CodeReading code_j = read_code(frame, m, false, layout, config_.detector);
+  if (!code_i.ok || !code_j.ok) {
+    ++counters_.unreadable_codes;
+    return false;
+  }
+  const double px_per_m = std::hypot(m.north_u, m.north_v);
+  if (code_i.code >= layout.codes() || code_j.code >= layout.codes() ||
+      !dark_area_consistent(red, code_i.code, true, layout, px_per_m) ||
+      !dark_area_consistent(green, code_j.code, false, layout, px_per_m)) {
+    ++counters_.inconsistent_markers;
+    return false;
+  }
+  MarkerObservation& o = *out;
+  o.code_i = code_i.code;
+  o.code_j = code_j.code;
+  o.centre_u_px = m.centre_u_px;
+  o.centre_v_px = m.centre_v_px;
+  o.red_u_px = red.cx;
+  o.red_v_px = red.cy;
+  o.green_u_px = green.cx;
+  o.green_v_px = green.cy;
+  o.west_image_rad = m.west_image_rad;
+  // Whole: the outline's corners project inside the frame.
+  bool whole = true;
+  const double half_e_m = layout.rect_width_m, half_n_m = 0.5 * layout.rect_height_m;
+  for (double se : {-1.0, 1.0}) {
+    for (double sn : {-1.0, 1.0}) {
+      double u = 0.0, v = 0.0;
+      m.project(se * half_e_m, sn * half_n_m, &u, &v);
+      whole = whole && u >= 0.0 && v >= 0.0 && u <= frame.width - 1.0 && v <= frame.height - 1.0;
+    }
+  }
+  o.whole = whole;
+  const float margin = std::min(code_i.margin, code_j.margin);
+  o.quality = std::clamp(margin / 0.3f, 0.0f, 1.0f) *
+              std::clamp(1.0f - static_cast<float>(pair.score) / 4.0f, 0.0f, 1.0f);
+  // Points for positioning: the centroids. Area centroids of the full
+  // rectangles (dots folded in) are unbiased under the affine view of a level
+  // camera, and thresholding shifts opposite edges alike.
+  o.point_count = 0;
+  o.points[o.point_count++] = {0.0, 0.0, m.centre_u_px, m.centre_v_px};
+  o.points[o.point_count++] = {layout.red_centre_e_m(), 0.0, red.cx, red.cy};
+  o.points[o.point_count++] = {layout.green_centre_e_m(), 0.0, green.cx, green.cy};
+  return true;
+}
+
+void Pipeline::process(const ImageView& frame, PositioningMode mode, FrameResult* out) {
+  const int64_t start_ns = monotonic_ns();
+  int64_t stamp_ns = start_ns;
+  auto lap = [&](int stage) {
+    const int64_t now_ns = monotonic_ns();
+    out->stage_ns[stage] = now_ns - stamp_ns;
+    stamp_ns = now_ns;
+  };
+  ++counters_.frames;
+  out->estimate = PoseEstimate{};
+  out->marker_count = 0;
+  out->stage_ns.fill(0);
+  rect_count_ = 0;
+  pair_count_ = 0;
+  if (!usable(frame)) {
+    ++counters_.unusable_frames;
+    out->total_ns = monotonic_ns() - start_ns;
+    return;
+  }
+
+  // 1. Classify every pixel (adaptive fused lookup) and build components.
+  if (frame.format != PixelFormat::kGray8 && !classifier_.adapt(frame)) {
+    ++counters_.white_reference_kept;
+  }
+  if (!labeler_.label(frame, classifier_)) ++counters_.run_budget_exceeded;
+  lap(kStageComponents);
+
+  // 2. Rectangle template fit.
+  rect_count_ =
+      static_cast<size_t>(fit_rectangles(labeler_.components(), model_, config_.detector, rects_));
+  lap(kStageRectangles);
+
+  // 3. Pair red with green; the red→green vector is West.
+  pair_count_ =
+      static_cast<size_t>(pairer_.pair(rectangles(), config_.layout, config_.detector, pairs_));
+  lap(kStagePairing);
+
+  // 4. Read the dots, check the code against the geometry, emit points.
+  for (size_t k = 0; k < pair_count_; ++k) {
+    if (out->marker_count == kMaxMarkersPerFrame) {
+      ++counters_.marker_overflow;
+      break;
+    }
+    if (decode(frame, pairs_[k], &out->markers[out->marker_count])) ++out->marker_count;
+  }
+  lap(kStageDecoding);
+
+  // 5. Positioning.
+  out->estimate = positioner_.solve(std::span(out->markers.data(), out->marker_count), mode);
+  lap(kStagePositioning);
+  out->total_ns = stamp_ns - start_ns;
+}
+
+}  // namespace ceilpose
