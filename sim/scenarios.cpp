@@ -173,7 +173,9 @@ constexpr std::array<Entry, 17> kEntries{{
      &clean},
     {"nominal", "uniform random poses, read noise sigma 0.5-3 levels (issue 3 'nominal')", nullptr,
      &nominal},
-    {"trajectory", "smooth figure-of-eight walk at 1.2 m/s over the grid, 30 fps, read noise 2",
+    {"trajectory",
+     "patrol loop over the grid at 1.2 m/s (lanes joined by U-turns of one grid unit radius), 30 "
+     "fps, read noise 2",
      &trajectory, nullptr},
     {"gain", "random poses, exposure gain 0.45-1.6 (auto-exposure)", nullptr, &gain},
     {"gradient", "random poses, illumination gradient 20-60% in a random direction", nullptr,
