@@ -1,6 +1,8 @@
 #include "ipc/shm/shm_pose_reader.h"
 
 #include <fcntl.h>
+#include <poll.h>
+#include <sys/inotify.h>
 #include <sys/mman.h>
 #include <sys/stat.h>
 #include <unistd.h>
@@ -244,6 +246,33 @@ Result<ShmPoseReader> ShmPoseReader::open(const std::string& name, ShmErrc* code
   impl->dev = st.st_dev;
   impl->ino = st.st_ino;
   return ShmPoseReader(std::move(impl));
+}
+
+Result<ShmPoseReader> ShmPoseReader::open_waiting(const std::string& name, int timeout_ms,
+                                                  ShmErrc* code) {
+  const int64_t deadline_ns = timeout_ms < 0 ? std::numeric_limits<int64_t>::max()
+                                             : monotonic_ns() + int64_t{timeout_ms} * 1'000'000;
+  // Creation shows up as IN_CREATE and sizing as IN_MODIFY; the header's
+  // magic is written through the mapping, which inotify cannot see, so the
+  // short not-ready window is re-checked on a timer.
+  FileDescriptor watch(::inotify_init1(IN_CLOEXEC | IN_NONBLOCK));
+  if (watch.valid()) {
+    ::inotify_add_watch(watch.get(), "/dev/shm", IN_CREATE | IN_MOVED_TO | IN_MODIFY);
+  }
+  for (;;) {
+    ShmErrc local = ShmErrc::kOk;
+    auto reader = open(name, &local);
+    if (code != nullptr) *code = local;
+    if (reader || (local != ShmErrc::kNotFound && local != ShmErrc::kNotReady)) return reader;
+    const int64_t remaining_ns = deadline_ns - monotonic_ns();
+    if (remaining_ns <= 0) return reader;
+    const int64_t slice_ms = local == ShmErrc::kNotReady ? 5 : 250;
+    pollfd pfd{watch.get(), POLLIN, 0};
+    ::poll(&pfd, 1, static_cast<int>(std::min(remaining_ns / 1'000'000 + 1, slice_ms)));
+    char events[4096];
+    while (watch.valid() && ::read(watch.get(), events, sizeof events) > 0) {
+    }
+  }
 }
 
 ShmPoseReader::ShmPoseReader(std::unique_ptr<Impl> impl) : impl_(std::move(impl)) {}

@@ -50,6 +50,11 @@ class ShmPoseReader {
   // Opens `name` read-only (and its "-wake" companion read-write) and checks
   // magic, ABI version and size. Errors name the segment, its size and mode.
   static Result<ShmPoseReader> open(const std::string& name, shm::ShmErrc* code = nullptr);
+  // Like open(), but while the segment is missing or still being initialized
+  // waits (inotify on /dev/shm, re-checked at least every 250 ms) up to
+  // timeout_ms (< 0: forever) for a daemon to create it.
+  static Result<ShmPoseReader> open_waiting(const std::string& name, int timeout_ms,
+                                            shm::ShmErrc* code = nullptr);
 
   ShmPoseReader(ShmPoseReader&&) noexcept;
   ShmPoseReader& operator=(ShmPoseReader&&) noexcept;

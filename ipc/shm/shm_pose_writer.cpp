@@ -118,6 +118,7 @@ struct ShmPoseWriter::Impl {
   WakeSegment* wake = nullptr;
   uint64_t seq = 0;
   uint32_t wake_seq = 0;
+  uint64_t wake_syscalls = 0;
   bool running = false;
   bool stopped = false;
 
@@ -141,6 +142,7 @@ struct ShmPoseWriter::Impl {
     seg->header.wake_seq.store(wake_seq, std::memory_order_seq_cst);
     if (always || wake->waiters.load(std::memory_order_seq_cst) != 0) {
       shm::futex_wake_shared(&seg->header.wake_seq);
+      ++wake_syscalls;
     }
   }
 
@@ -351,7 +353,8 @@ void ShmPoseWriter::publish(const PoseRecord& pose) {
   Impl& w = *impl_;
   PoseRecord p = pose;
   p.seq = ++w.seq;
-  if (p.publish_mono_ns == 0) p.publish_mono_ns = monotonic_ns();
+  const int64_t now_ns = monotonic_ns();
+  if (p.publish_mono_ns == 0) p.publish_mono_ns = now_ns;
   if (p.publish_real_ns == 0) p.publish_real_ns = realtime_ns();
   auto& h = w.seg->header;
   w.seg->latest.store(p);
@@ -361,7 +364,7 @@ void ShmPoseWriter::publish(const PoseRecord& pose) {
     h.state.store(static_cast<uint32_t>(WriterState::kRunning), std::memory_order_release);
     w.running = true;
   }
-  h.heartbeat_mono_ns.store(p.publish_mono_ns, std::memory_order_release);
+  h.heartbeat_mono_ns.store(now_ns, std::memory_order_release);
   w.wake_readers(false);
 }
 
@@ -379,5 +382,6 @@ void ShmPoseWriter::mark_stopped() { impl_->mark_stopped(); }
 const std::string& ShmPoseWriter::name() const { return impl_->name; }
 uint64_t ShmPoseWriter::generation() const { return impl_->seg->header.generation; }
 uint64_t ShmPoseWriter::last_seq() const { return impl_->seq; }
+uint64_t ShmPoseWriter::wake_syscalls() const { return impl_->wake_syscalls; }
 
 }  // namespace ceilpose

@@ -61,6 +61,9 @@ class ShmPoseWriter {
   const std::string& name() const;
   uint64_t generation() const;
   uint64_t last_seq() const;  // 0 before the first publish
+  // FUTEX_WAKE calls made so far: publish() makes one only when a reader is
+  // registered as waiting, so this stays 0 with no blocked readers.
+  uint64_t wake_syscalls() const;
 
  private:
   struct Impl;

@@ -1,0 +1,148 @@
+// The C API over a live writer: codes, messages, and the example program.
+#include <gtest/gtest.h>
+
+#include <set>
+#include <string>
+
+#include "ceilpose/pose_client.h"
+#include "ipc/shm/shm_pose_writer.h"
+#include "shm_test_support.h"
+
+namespace ceilpose {
+namespace {
+
+using test::check_pose;
+using test::is_consistent;
+
+class CClient : public test::ShmFixture {};
+
+struct ClientCloser {
+  void operator()(ceilpose_client* c) const { ceilpose_client_close(c); }
+};
+using ClientPtr = std::unique_ptr<ceilpose_client, ClientCloser>;
+
+ClientPtr open_client(const std::string& name) {
+  ceilpose_client* raw = nullptr;
+  const int rc = ceilpose_client_open(name.c_str(), &raw);
+  EXPECT_EQ(rc, CEILPOSE_OK) << ceilpose_last_error_message();
+  return ClientPtr(raw);
+}
+
+TEST_F(CClient, OpenOfMissingSegmentReturnsNotFoundWithMessageNamingIt) {
+  ceilpose_client* c = nullptr;
+  EXPECT_EQ(ceilpose_client_open(name().c_str(), &c), CEILPOSE_ERR_NOT_FOUND);
+  EXPECT_EQ(c, nullptr);
+  EXPECT_NE(std::string(ceilpose_last_error_message()).find(name()), std::string::npos);
+}
+
+TEST_F(CClient, NullArgumentsAreInvalid) {
+  EXPECT_EQ(ceilpose_client_open("/x", nullptr), CEILPOSE_ERR_INVALID_ARGUMENT);
+  ceilpose_pose p;
+  EXPECT_EQ(ceilpose_client_read_latest(nullptr, &p), CEILPOSE_ERR_INVALID_ARGUMENT);
+  EXPECT_EQ(ceilpose_client_wait_next(nullptr, 0, 0, &p), CEILPOSE_ERR_INVALID_ARGUMENT);
+  ceilpose_client_close(nullptr);
+}
+
+TEST_F(CClient, ReadsLatestPoseStatusAndWriterInfo) {
+  ASSERT_NO_FATAL_FAILURE(start());
+  ClientPtr client = open_client(name());
+  ASSERT_NE(client, nullptr);
+  ceilpose_client* raw = client.get();
+
+  ceilpose_pose p;
+  EXPECT_EQ(ceilpose_client_read_latest(raw, &p), CEILPOSE_ERR_NO_POSE);
+  writer().publish(check_pose(1));
+  writer().publish(check_pose(2));
+  ASSERT_EQ(ceilpose_client_read_latest(raw, &p), CEILPOSE_OK);
+  EXPECT_EQ(p.seq, 2u);
+  EXPECT_TRUE(is_consistent(p));
+
+  StatusRecord s{};
+  s.fps = 30.0;
+  s.frames = 42;
+  s.fix_state = CEILPOSE_FIX_OK;
+  set_status_source(&s, "synthetic");
+  writer().update_status(s);
+  ceilpose_status cs;
+  ASSERT_EQ(ceilpose_client_read_status(raw, &cs), CEILPOSE_OK);
+  EXPECT_EQ(cs.frames, 42u);
+  EXPECT_STREQ(cs.source, "synthetic");
+
+  ceilpose_writer_info info;
+  ASSERT_EQ(ceilpose_client_writer_info(raw, &info), CEILPOSE_OK);
+  EXPECT_EQ(info.pid, ::getpid());
+  EXPECT_EQ(info.generation, writer().generation());
+  EXPECT_EQ(info.state, static_cast<uint32_t>(CEILPOSE_STATE_RUNNING));
+
+  ceilpose_liveness live;
+  ASSERT_EQ(ceilpose_client_liveness(raw, 1000, &live), CEILPOSE_OK);
+  EXPECT_EQ(live, CEILPOSE_LIVE);
+}
+
+TEST_F(CClient, WaitNextReturnsPoseThenTimesOut) {
+  ASSERT_NO_FATAL_FAILURE(start());
+  ClientPtr client = open_client(name());
+  ASSERT_NE(client, nullptr);
+  ceilpose_client* raw = client.get();
+  writer().publish(check_pose(1));
+  ceilpose_pose p;
+  EXPECT_EQ(ceilpose_client_wait_next(raw, 0, 1000, &p), CEILPOSE_OK);
+  EXPECT_EQ(p.seq, 1u);
+  EXPECT_EQ(ceilpose_client_wait_next(raw, 1, 50, &p), CEILPOSE_ERR_TIMEOUT);
+  writer().mark_stopped();
+  EXPECT_EQ(ceilpose_client_wait_next(raw, 1, 1000, &p), CEILPOSE_ERR_STOPPED);
+}
+
+TEST_F(CClient, ReadRecentReturnsNewestFirst) {
+  ASSERT_NO_FATAL_FAILURE(start());
+  ClientPtr client = open_client(name());
+  ASSERT_NE(client, nullptr);
+  ceilpose_client* raw = client.get();
+  for (uint64_t k = 1; k <= 10; ++k) writer().publish(check_pose(k));
+  ceilpose_pose recent[4];
+  uint32_t n = 0;
+  ASSERT_EQ(ceilpose_client_read_recent(raw, recent, 4, &n), CEILPOSE_OK);
+  ASSERT_EQ(n, 4u);
+  EXPECT_EQ(recent[0].seq, 10u);
+  EXPECT_EQ(recent[3].seq, 7u);
+}
+
+TEST_F(CClient, EveryErrorCodeHasItsOwnText) {
+  std::set<std::string> texts;
+  for (int code = CEILPOSE_OK; code >= CEILPOSE_ERR_NO_GROUP; --code) {
+    texts.insert(ceilpose_strerror(code));
+  }
+  EXPECT_EQ(texts.size(), static_cast<size_t>(1 - CEILPOSE_ERR_NO_GROUP));
+  EXPECT_EQ(texts.count(ceilpose_strerror(-1000)), 0u);
+}
+
+TEST_F(CClient, ExamplePrinterPrintsPublishedPoses) {
+  ASSERT_NO_FATAL_FAILURE(start());
+  for (uint64_t k = 1; k <= 3; ++k) writer().publish(check_pose(k));
+  std::thread more([&] {
+    for (uint64_t k = 4; k <= 6; ++k) {
+      std::this_thread::sleep_for(std::chrono::milliseconds(30));
+      writer().publish(check_pose(k));
+    }
+  });
+  std::string out;
+  std::string err;
+  const int rc = test::run_program(CEILPOSE_POSE_PRINTER_PATH, {"--shm", name(), "--count", "3"},
+                                   30'000, &out, &err);
+  more.join();
+  EXPECT_EQ(rc, 0) << err;
+  EXPECT_EQ(std::count(out.begin(), out.end(), '\n'), 3) << out;
+  EXPECT_NE(out.find("seq"), std::string::npos) << out;
+}
+
+TEST_F(CClient, ExamplePrinterExitsNoDaemonWhenSegmentMissing) {
+  std::string out;
+  std::string err;
+  const int rc =
+      test::run_program(CEILPOSE_POSE_PRINTER_PATH, {"--shm", name()}, 30'000, &out, &err);
+  EXPECT_EQ(rc, 3) << err;
+  EXPECT_NE(err.find(name()), std::string::npos) << err;
+}
+
+}  // namespace
+}  // namespace ceilpose

@@ -1,0 +1,208 @@
+#include "shm_test_support.h"
+
+#include <fcntl.h>
+#include <gtest/gtest.h>
+#include <poll.h>
+#include <signal.h>
+#include <spawn.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <cerrno>
+#include <cstdlib>
+#include <cstring>
+
+#include "core/clock.h"
+
+extern char** environ;
+
+namespace ceilpose::test {
+
+std::string unique_shm_name() {
+  const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
+  std::string test = info != nullptr ? info->name() : "none";
+  for (char& c : test) {
+    if (c == '/') c = '_';
+  }
+  return "/ceilpose-test-" + std::to_string(::getpid()) + "-" + test.substr(0, 150);
+}
+
+ScopedSegmentName::~ScopedSegmentName() { (void)ShmPoseWriter::remove(name_); }
+
+PoseRecord check_pose(uint64_t k) {
+  PoseRecord p{};
+  p.capture_mono_ns = static_cast<int64_t>(k) * 3;
+  p.capture_real_ns = static_cast<int64_t>(k) * 5;
+  p.publish_mono_ns = static_cast<int64_t>(k) * 7;
+  p.publish_real_ns = static_cast<int64_t>(k) * 11;
+  p.x_m = static_cast<double>(k);
+  p.y_m = -0.5 * static_cast<double>(k);
+  p.yaw_rad = static_cast<double>(k % 1000) * 1e-3;
+  for (int i = 0; i < 9; ++i) p.covariance[i] = static_cast<double>(k + i);
+  p.flags = kPoseValid | static_cast<uint32_t>((k & 1) != 0 ? kPoseFiltered : 0);
+  p.mode = static_cast<uint8_t>(k % 4);
+  p.markers = static_cast<uint16_t>(k & 0xffff);
+  return p;
+}
+
+bool is_consistent(const PoseRecord& p) {
+  PoseRecord expected = check_pose(p.seq);
+  expected.seq = p.seq;
+  return std::memcmp(&expected, &p, sizeof p) == 0;
+}
+
+namespace {
+
+bool wait_byte(int fd, int timeout_ms) {
+  pollfd pfd{fd, POLLIN, 0};
+  if (::poll(&pfd, 1, timeout_ms) != 1) return false;
+  char c = 0;
+  return ::read(fd, &c, 1) == 1;
+}
+
+void send_byte(int fd) {
+  const char c = 1;
+  while (::write(fd, &c, 1) < 0 && errno == EINTR) {
+  }
+}
+
+}  // namespace
+
+ChildProcess::ChildProcess(Body body) {
+  if (::pipe2(to_parent_, O_CLOEXEC) != 0 || ::pipe2(to_child_, O_CLOEXEC) != 0) {
+    ADD_FAILURE() << "pipe2 failed: " << std::strerror(errno);
+    return;
+  }
+  pid_ = ::fork();
+  if (pid_ == 0) {
+    ::close(to_parent_[0]);
+    ::close(to_child_[1]);
+    const int rc = body(*this);
+    ::_exit(rc);
+  }
+  ::close(to_parent_[1]);
+  ::close(to_child_[0]);
+  to_parent_[1] = -1;
+  to_child_[0] = -1;
+}
+
+ChildProcess::~ChildProcess() {
+  if (pid_ > 0 && !reaped_) {
+    ::kill(pid_, SIGKILL);
+    ::waitpid(pid_, nullptr, 0);
+  }
+  for (int fd : {to_parent_[0], to_child_[1]}) {
+    if (fd >= 0) ::close(fd);
+  }
+}
+
+bool ChildProcess::wait_for_child(int timeout_ms) { return wait_byte(to_parent_[0], timeout_ms); }
+void ChildProcess::release_child() { send_byte(to_child_[1]); }
+void ChildProcess::notify_parent() { send_byte(to_parent_[1]); }
+bool ChildProcess::wait_for_parent(int timeout_ms) { return wait_byte(to_child_[0], timeout_ms); }
+
+void ChildProcess::kill_child(int signal) {
+  if (pid_ > 0 && !reaped_) ::kill(pid_, signal);
+}
+
+int ChildProcess::wait_exit(int timeout_ms) {
+  if (pid_ <= 0) return -1;
+  const int64_t deadline = monotonic_ns() + int64_t{timeout_ms} * 1'000'000;
+  for (;;) {
+    int status = 0;
+    const pid_t r = ::waitpid(pid_, &status, WNOHANG);
+    if (r == pid_) {
+      reaped_ = true;
+      if (WIFEXITED(status)) return WEXITSTATUS(status);
+      if (WIFSIGNALED(status)) return 128 + WTERMSIG(status);
+      return -1;
+    }
+    if (monotonic_ns() > deadline) return -1;
+    ::usleep(2000);
+  }
+}
+
+ChildProcess::Body writer_child(const std::string& name,
+                                std::function<int(ShmPoseWriter&, ChildProcess&)> then) {
+  return [name, then](ChildProcess& self) {
+    ShmOptions options;
+    options.name = name;
+    auto writer = ShmPoseWriter::create(options);
+    if (!writer) return 10;
+    return then(writer.value(), self);
+  };
+}
+
+void ShmFixture::start(int heartbeat_period_ms) {
+  ShmOptions options;
+  options.name = name();
+  options.heartbeat_period_ms = heartbeat_period_ms;
+  auto writer = ShmPoseWriter::create(options);
+  ASSERT_TRUE(writer) << writer.error().message;
+  writer_.emplace(std::move(writer.value()));
+  auto reader = ShmPoseReader::open(name());
+  ASSERT_TRUE(reader) << reader.error().message;
+  reader_.emplace(std::move(reader.value()));
+}
+
+int run_program(const std::string& path, const std::vector<std::string>& args, int timeout_ms,
+                std::string* stdout_text, std::string* stderr_text) {
+  int out[2];
+  int err[2];
+  if (::pipe2(out, O_CLOEXEC) != 0 || ::pipe2(err, O_CLOEXEC) != 0) return -1;
+  posix_spawn_file_actions_t actions;
+  posix_spawn_file_actions_init(&actions);
+  posix_spawn_file_actions_adddup2(&actions, out[1], 1);
+  posix_spawn_file_actions_adddup2(&actions, err[1], 2);
+  std::vector<char*> argv;
+  argv.push_back(const_cast<char*>(path.c_str()));
+  for (const auto& a : args) argv.push_back(const_cast<char*>(a.c_str()));
+  argv.push_back(nullptr);
+  pid_t pid = -1;
+  const int rc = ::posix_spawn(&pid, path.c_str(), &actions, nullptr, argv.data(), environ);
+  posix_spawn_file_actions_destroy(&actions);
+  ::close(out[1]);
+  ::close(err[1]);
+  if (rc != 0) {
+    ::close(out[0]);
+    ::close(err[0]);
+    return -1;
+  }
+  std::string o;
+  std::string e;
+  const int64_t deadline = monotonic_ns() + int64_t{timeout_ms} * 1'000'000;
+  bool out_open = true;
+  bool err_open = true;
+  bool timed_out = false;
+  while (out_open || err_open) {
+    const int64_t left_ms = (deadline - monotonic_ns()) / 1'000'000;
+    if (left_ms <= 0) {
+      timed_out = true;
+      break;
+    }
+    pollfd pfds[2] = {{out_open ? out[0] : -1, POLLIN, 0}, {err_open ? err[0] : -1, POLLIN, 0}};
+    if (::poll(pfds, 2, static_cast<int>(left_ms)) <= 0) continue;
+    char buf[4096];
+    for (int i = 0; i < 2; ++i) {
+      if ((pfds[i].revents & (POLLIN | POLLHUP)) == 0) continue;
+      const ssize_t n = ::read(pfds[i].fd, buf, sizeof buf);
+      if (n > 0) {
+        (i == 0 ? o : e).append(buf, static_cast<size_t>(n));
+      } else {
+        (i == 0 ? out_open : err_open) = false;
+      }
+    }
+  }
+  ::close(out[0]);
+  ::close(err[0]);
+  if (timed_out) ::kill(pid, SIGKILL);
+  int status = 0;
+  ::waitpid(pid, &status, 0);
+  if (stdout_text != nullptr) *stdout_text = o;
+  if (stderr_text != nullptr) *stderr_text = e;
+  if (timed_out) return -1;
+  if (WIFEXITED(status)) return WEXITSTATUS(status);
+  return 128 + WTERMSIG(status);
+}
+
+}  // namespace ceilpose::test
