@@ -158,7 +158,7 @@ Result<FrameFileInfo> inspect_jpeg(const uint8_t* data, size_t size) {
 
 }  // namespace
 
-const char* to_string(FrameEncoding e) { return e == FrameEncoding::kPng ? "png" : "jpeg"; }
+const char* to_string(FrameEncoding e) { return e == FrameEncoding::kPng ? "PNG" : "JPEG"; }
 
 Result<FrameFileInfo> inspect_frame_bytes(const uint8_t* data, size_t size) {
   if (size >= kPngSignature.size() &&
