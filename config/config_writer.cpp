@@ -31,16 +31,20 @@ std::string double_text(T v) {
   return s;
 }
 
+// Writes YAML text to `out`, or (flat) collects "section.key" -> value pairs.
 class Writer {
  public:
   explicit Writer(std::ostringstream* out) : out_(out) {}
+  explicit Writer(std::vector<std::pair<std::string, std::string>>* flat) : flat_(flat) {}
 
   template <typename Fn>
   void section(const char* name, Fn fn) {
-    line(name, "");
+    if (out_ != nullptr) line(name, "");
+    prefix_ = std::string(name) + ".";
     indent_ += 2;
     fn();
     indent_ -= 2;
+    prefix_.clear();
   }
   void field(const char* name, int& v, int, int) { line(name, std::to_string(v)); }
   void field(const char* name, uint64_t& v, uint64_t, uint64_t) { line(name, std::to_string(v)); }
@@ -79,10 +83,16 @@ class Writer {
 
  private:
   void line(const char* name, const std::string& value) {
+    if (flat_ != nullptr) {
+      flat_->emplace_back(prefix_ + name, value);
+      return;
+    }
     *out_ << std::string(indent_, ' ') << name << ":" << (value.empty() ? "" : " ") << value
           << "\n";
   }
-  std::ostringstream* out_;
+  std::ostringstream* out_ = nullptr;
+  std::vector<std::pair<std::string, std::string>>* flat_ = nullptr;
+  std::string prefix_;
   int indent_ = 0;
 };
 
@@ -134,6 +144,23 @@ std::string dump_config(const ServiceConfig& config) {
   Writer writer(&out);
   config_detail::describe(writer, copy);
   return out.str();
+}
+
+std::vector<std::pair<std::string, std::string>> config_values(const ServiceConfig& config) {
+  ServiceConfig copy = config;
+  std::vector<std::pair<std::string, std::string>> values;
+  Writer writer(&values);
+  config_detail::describe(writer, copy);
+  return values;
+}
+
+std::vector<std::string> changed_config_keys(const ServiceConfig& a, const ServiceConfig& b) {
+  const auto va = config_values(a);
+  const auto vb = config_values(b);
+  std::vector<std::string> changed;
+  for (size_t i = 0; i < va.size(); ++i)
+    if (va[i].second != vb[i].second) changed.push_back(va[i].first);
+  return changed;
 }
 
 std::vector<std::string> config_key_paths() {

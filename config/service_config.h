@@ -5,6 +5,7 @@
 // checks that file and default_config() agree).
 #include <cstdint>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "core/result.h"
@@ -112,6 +113,11 @@ Result<std::vector<std::string>> missing_config_keys(const std::string& yaml_tex
 
 // Every key path the schema knows, in file order (e.g. `camera.fx`).
 std::vector<std::string> config_key_paths();
+
+// Every key with its value as YAML text ("camera.fx" -> "530.0"), file order.
+std::vector<std::pair<std::string, std::string>> config_values(const ServiceConfig& config);
+// Key paths whose values differ (what a SIGHUP reload changes).
+std::vector<std::string> changed_config_keys(const ServiceConfig& a, const ServiceConfig& b);
 
 // The configuration as YAML, every key present (`ceilposed --print-config`).
 std::string dump_config(const ServiceConfig& config);

@@ -151,5 +151,13 @@ TEST(ConfigOverrides, BadValueNamesTheOption) {
               HasSubstr("--domain: dds.domain_id: expected a value in [0, 230]"));
 }
 
+TEST(ConfigDiff, NamesExactlyTheChangedKeys) {
+  ServiceConfig changed = default_config();
+  changed.pipeline.detector.min_rect_area_px += 1;
+  changed.capture.fps = 60.0;
+  EXPECT_EQ(changed_config_keys(default_config(), changed),
+            (std::vector<std::string>{"detector.min_rect_area_px", "capture.fps"}));
+}
+
 }  // namespace
 }  // namespace ceilpose

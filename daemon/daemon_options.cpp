@@ -1,0 +1,72 @@
+#include "daemon/daemon_options.h"
+
+#include <CLI/CLI.hpp>
+#include <cstdio>
+
+#include "daemon/exit_codes.h"
+
+namespace ceilpose::daemon {
+
+bool parse_command_line(int argc, char** argv, DaemonOptions* options, int* exit_code) {
+  CLI::App app{
+      "ceilposed - localizes the robot from coded ceiling markers and publishes its pose\n"
+      "on shared memory and DDS (ROS 2 PoseWithCovarianceStamped on rt/<robot>/pose).\n"
+      "Command-line options override the configuration file; defaults are SPEC.md's.\n"
+      "Signals: SIGTERM/SIGINT stop cleanly, SIGHUP reloads the configuration file.\n"
+      "Exit codes: 0 ok, 1 runtime failure, 2 usage error, 3 bad configuration,\n"
+      "4 frame source failure."};
+  app.set_version_flag("--version", "ceilposed 0.1.0");
+
+  std::string source, robot, shm, log_level;
+  int domain = -1;
+  bool no_dds = false;
+  // Not CLI::ExistingFile: a missing file is a configuration error (exit 3)
+  // reported by the loader like any other.
+  app.add_option("--config", options->config_path,
+                 "YAML configuration file (config/ceilpose.yaml)");
+  app.add_option("--source", source,
+                 "frame source: synthetic | replay:DIR | v4l2:/dev/videoN | libcamera[:ID]");
+  app.add_option("--robot", robot, "robot name, the DDS topic prefix (default: host name)");
+  app.add_option("--shm", shm, "shared-memory segment name (default /ceilpose)");
+  app.add_option("--domain", domain, "DDS domain id (default 0)");
+  app.add_flag("--no-dds", no_dds, "publish on shared memory only");
+  app.add_option("--log-level", log_level, "trace | debug | info | warn | error | critical | off");
+  app.add_option("--duration", options->duration_s,
+                 "stop after SECONDS (default: run until stopped)")
+      ->check(CLI::NonNegativeNumber);
+  app.add_flag("--print-poses", options->print_poses,
+               "print a line per pose (at most 10 per second): time, x, y, yaw, mode, markers,\n"
+               "ground truth and error when the source knows it, latency");
+  app.add_option("--check-config", options->check_config_path,
+                 "validate FILE and exit: 0 when valid, 3 with the problem on stderr");
+  app.add_flag("--print-config", options->print_config,
+               "print the effective configuration (file + options) as YAML and exit");
+
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    const int rc = app.exit(e);
+    *exit_code = rc == 0 ? kExitOk : kExitUsage;
+    return false;
+  }
+  if (!source.empty()) options->overrides.push_back({"capture.source", source, "--source"});
+  if (!robot.empty()) options->overrides.push_back({"dds.robot_name", robot, "--robot"});
+  if (!shm.empty()) options->overrides.push_back({"ipc.shm_name", shm, "--shm"});
+  if (domain >= 0 || app.count("--domain") > 0)
+    options->overrides.push_back({"dds.domain_id", std::to_string(domain), "--domain"});
+  if (no_dds) options->overrides.push_back({"dds.enabled", "false", "--no-dds"});
+  if (!log_level.empty()) options->overrides.push_back({"logging.level", log_level, "--log-level"});
+  return true;
+}
+
+Result<ServiceConfig> resolve_config(const DaemonOptions& options) {
+  ServiceConfig base = default_config();
+  if (!options.config_path.empty()) {
+    auto loaded = load_config_file(options.config_path);
+    if (!loaded) return loaded.error();
+    base = std::move(loaded).value();
+  }
+  return apply_overrides(base, options.overrides);
+}
+
+}  // namespace ceilpose::daemon

@@ -1,0 +1,15 @@
+#pragma once
+// Exit codes of ceilposed (documented in --help and docs/service.md). systemd's
+// Restart=on-failure restarts on any of the non-zero ones; the unit's
+// RestartPreventExitStatus stops it retrying a configuration that cannot work.
+namespace ceilpose::daemon {
+
+enum ExitCode : int {
+  kExitOk = 0,             // stopped by SIGTERM/SIGINT, --duration elapsed, or the replay ended
+  kExitRuntime = 1,        // failure while running (pipeline thread, shared memory, DDS)
+  kExitUsage = 2,          // bad command line
+  kExitBadConfig = 3,      // configuration file missing, malformed or out of range
+  kExitSourceFailure = 4,  // the frame source could not be opened or failed for good
+};
+
+}  // namespace ceilpose::daemon

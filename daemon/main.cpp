@@ -1,0 +1,44 @@
+// ceilposed: the ceiling-marker positioning service (SPEC §7, docs/service.md).
+#include <cstdio>
+#include <exception>
+
+#include "daemon/daemon_options.h"
+#include "daemon/exit_codes.h"
+#include "daemon/logging.h"
+#include "daemon/service.h"
+
+int main(int argc, char** argv) {
+  using namespace ceilpose;
+  using namespace ceilpose::daemon;
+  DaemonOptions options;
+  int exit_code = kExitOk;
+  if (!parse_command_line(argc, argv, &options, &exit_code)) return exit_code;
+
+  if (!options.check_config_path.empty()) {
+    auto checked = load_config_file(options.check_config_path);
+    if (!checked) {
+      std::fprintf(stderr, "ceilposed: %s\n", checked.error().message.c_str());
+      return kExitBadConfig;
+    }
+    std::printf("%s: valid\n", options.check_config_path.c_str());
+    return kExitOk;
+  }
+
+  auto config = resolve_config(options);
+  if (!config) {
+    std::fprintf(stderr, "ceilposed: %s\n", config.error().message.c_str());
+    return kExitBadConfig;
+  }
+  if (options.print_config) {
+    std::fputs(dump_config(*config).c_str(), stdout);
+    return kExitOk;
+  }
+
+  setup_logging(detect_log_target(), config->logging.level);
+  try {
+    return run_service(*config, options);
+  } catch (const std::exception& e) {
+    spdlog::critical("ceilposed: {}", e.what());
+    return kExitRuntime;
+  }
+}

@@ -1,0 +1,130 @@
+#pragma once
+// The pipeline thread of ceilposed: takes the newest frame from the capture
+// thread, localizes it, filters the pose, publishes it on shared memory and
+// DDS, and stamps the frame's latency. It is also the single writer of the
+// shared-memory segment and the DDS writers while it runs (both require one
+// thread), so it refreshes their status records too.
+//
+// Per frame: no allocation, no exception, no logging; problems are counted in
+// ProblemCounters and progress in ProgressCounter (the watchdog's evidence).
+//
+// Threads: constructor, start(), stop(), reload() and the accessors from the
+// control thread; everything else runs on the worker's own thread.
+#include <atomic>
+#include <cstdint>
+#include <memory>
+#include <mutex>
+#include <optional>
+#include <thread>
+
+#include "capture/capture_thread.h"
+#include "capture/latency_histogram.h"
+#include "config/service_config.h"
+#include "daemon/logging.h"
+#include "daemon/watchdog_gate.h"
+#include "ipc/shm/shm_pose_writer.h"
+#include "pipeline/pipeline.h"
+#include "pipeline/temporal_filter.h"
+
+namespace ceilpose {
+class DdsPosePublisher;
+}
+
+namespace ceilpose::daemon {
+
+// The latest published pose as the control thread sees it (--print-poses,
+// STATUS=). Trivially copyable.
+struct PoseSnapshot {
+  uint64_t seq = 0;  // shared-memory sequence number; 0 = none yet
+  int64_t capture_ns = 0;
+  bool valid = false;
+  Pose2D pose;
+  PositioningMode mode = PositioningMode::kAuto;
+  int markers = 0;
+  bool has_ground_truth = false;
+  Pose2D ground_truth;
+  int64_t latency_ns = 0;  // frame dequeued -> pose published
+  FixState fix = FixState::kNone;
+  double fps = 0.0;
+};
+
+struct WorkerOptions {
+  int status_interval_ms = 1000;
+  // Test hook (CEILPOSE_TEST_STALL_AFTER_FRAMES, docs/service.md): after this
+  // many frames the thread stops making progress until stop(), as a hung
+  // pipeline would. 0 = never.
+  uint64_t stall_after_frames = 0;
+};
+
+class PipelineWorker {
+ public:
+  PipelineWorker(const ServiceConfig& config, WorkerOptions options,
+                 capture::CaptureThread* capture, ShmPoseWriter* shm, DdsPosePublisher* dds,
+                 ProblemCounters* problems, ProgressCounter* progress);
+  ~PipelineWorker();
+  PipelineWorker(const PipelineWorker&) = delete;
+  PipelineWorker& operator=(const PipelineWorker&) = delete;
+
+  void start();
+  // Asks the thread to finish its frame and joins it.
+  void stop();
+
+  // Hands the live part of `config` (pipeline tuning, positioning mode,
+  // filter) to the thread, which applies it between two frames.
+  void reload(const ServiceConfig& config, bool reset_filter);
+
+  // The thread left because the source ended or failed.
+  bool finished() const { return finished_.load(std::memory_order_acquire); }
+  PoseSnapshot latest() const;
+  const capture::FrameLatency& latency() const { return latency_; }
+  uint64_t frames() const { return frames_.load(std::memory_order_relaxed); }
+
+ private:
+  struct Pending {
+    PipelineConfig pipeline;
+    PositioningMode mode;
+    bool reset_filter;
+  };
+
+  void run();
+  void apply_pending();
+  void process(const capture::Frame& frame);
+  void publish_status(int64_t now_ns);
+  void stall_until_stopped();
+
+  const WorkerOptions options_;
+  capture::CaptureThread* capture_;
+  ShmPoseWriter* shm_;
+  DdsPosePublisher* dds_;
+  ProblemCounters* problems_;
+  ProgressCounter* progress_;
+
+  // Pipeline-thread state.
+  Pipeline pipeline_;
+  PositioningMode mode_;
+  bool filter_enabled_;
+  TemporalFilter filter_;
+  FrameResult result_;
+  bool had_fix_ = false;
+  FixState fix_ = FixState::kNone;
+  int64_t next_status_ns_ = 0;
+  uint64_t frames_at_status_ = 0;
+  int64_t status_ns_ = 0;
+  double fps_ = 0.0;
+  PoseSnapshot last_;
+
+  capture::FrameLatency latency_;
+  std::atomic<uint64_t> frames_{0};
+  std::atomic<bool> stop_{false};
+  std::atomic<bool> finished_{false};
+  std::thread thread_;
+
+  mutable std::mutex snapshot_mutex_;  // writer only try_locks: never waits
+  PoseSnapshot snapshot_;
+
+  std::mutex pending_mutex_;
+  std::atomic<bool> has_pending_{false};
+  std::optional<Pending> pending_;
+};
+
+}  // namespace ceilpose::daemon

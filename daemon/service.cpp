@@ -1,0 +1,397 @@
+#include "daemon/service.h"
+
+#include <unistd.h>
+
+#include <algorithm>
+#include <cinttypes>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <memory>
+#include <numbers>
+#include <sstream>
+#include <string>
+
+#include "capture/capture_thread.h"
+#include "capture/frame_source.h"
+#include "core/clock.h"
+#include "daemon/exit_codes.h"
+#include "daemon/logging.h"
+#include "daemon/pipeline_worker.h"
+#include "daemon/signal_channel.h"
+#include "daemon/systemd_notifier.h"
+#include "daemon/watchdog_gate.h"
+#include "ipc/shm/shm_pose_writer.h"
+#ifdef CEILPOSE_DAEMON_HAVE_DDS
+#include "ipc/dds/dds_options.h"
+#include "ipc/dds/dds_pose_publisher.h"
+#endif
+
+namespace ceilpose::daemon {
+namespace {
+
+constexpr int64_t kMsNs = 1'000'000;
+constexpr int64_t kPrintPeriodNs = 100 * kMsNs;  // --print-poses: at most 10 lines a second
+
+// Keys SIGHUP applies without a restart: everything the pipeline thread can
+// take between two frames. The image size fixes buffers and the capture format.
+bool live_key(const std::string& key) {
+  if (key == "camera.width" || key == "camera.height") return false;
+  for (const char* prefix :
+       {"camera.", "mount.", "ceiling.", "detector.", "positioning.", "filter.", "logging."})
+    if (key.rfind(prefix, 0) == 0) return true;
+  return false;
+}
+
+std::vector<PixelFormat> pixel_formats(const std::string& name) {
+  if (name == "yuyv") return {PixelFormat::kYuyv};
+  if (name == "mjpeg") return {PixelFormat::kMjpeg};
+  if (name == "rgb24") return {PixelFormat::kRgb24};
+  if (name == "bgr24") return {PixelFormat::kBgr24};
+  if (name == "gray8") return {PixelFormat::kGray8};
+  return capture::SourceOptions{}.pixel_formats;  // auto: the backend's preference order
+}
+
+capture::SourceOptions source_options(const ServiceConfig& c) {
+  capture::SourceOptions o;
+  o.width = c.capture.width_px;
+  o.height = c.capture.height_px;
+  o.fps = c.capture.fps;
+  o.pixel_formats = pixel_formats(c.capture.pixel_format);
+  o.buffer_count = c.capture.buffer_count;
+  o.controls.lock_exposure = c.capture.lock_exposure;
+  o.controls.exposure_us = c.capture.exposure_us;
+  o.controls.lock_gain = c.capture.lock_gain;
+  o.controls.gain = c.capture.gain;
+  o.controls.lock_white_balance = c.capture.lock_white_balance;
+  o.controls.white_balance_k = c.capture.white_balance_k;
+  o.stall_timeout_ms = c.capture.stall_timeout_ms;
+  o.reconnect_initial_ms = c.capture.reconnect_initial_ms;
+  o.reconnect_max_ms = c.capture.reconnect_max_ms;
+  o.replay_as_fast_as_possible = c.capture.replay_speed == 0.0;
+  o.replay_speed = o.replay_as_fast_as_possible ? 1.0 : c.capture.replay_speed;
+  o.replay_loop = c.capture.replay_loop;
+  o.intrinsics = c.pipeline.intrinsics;
+  o.layout = c.pipeline.layout;
+  o.mount = c.pipeline.mount;
+  o.seed = c.capture.synthetic_seed;
+  return o;
+}
+
+// Test hook, documented in docs/service.md: only tests set it.
+uint64_t stall_after_frames_from_env() {
+  const char* env = std::getenv("CEILPOSE_TEST_STALL_AFTER_FRAMES");
+  if (env == nullptr) return 0;
+  const uint64_t n = std::strtoull(env, nullptr, 10);
+  spdlog::warn(
+      "CEILPOSE_TEST_STALL_AFTER_FRAMES={}: the pipeline will hang after {} frames "
+      "(test hook; the watchdog is expected to fire)",
+      env, n);
+  return n;
+}
+
+const char* fix_name(FixState fix) { return to_string(fix); }
+
+std::string status_line(const PoseSnapshot& s, const capture::FrameLatency& latency) {
+  const capture::LatencySummary lat = latency.dequeue_to_published().summary();
+  char buf[200];
+  std::snprintf(buf, sizeof(buf), "fix %s, %d markers, %.1f fps, latency p50 %.2f ms p99 %.2f ms",
+                fix_name(s.fix), s.markers, s.fps, static_cast<double>(lat.p50_us) / 1000.0,
+                static_cast<double>(lat.p99_us) / 1000.0);
+  return buf;
+}
+
+void print_pose(const PoseSnapshot& s, int64_t start_ns) {
+  constexpr double kDeg = 180.0 / std::numbers::pi;
+  const double t_s = static_cast<double>(s.capture_ns - start_ns) * 1e-9;
+  char line[320];
+  int n = 0;
+  if (s.valid) {
+    n = std::snprintf(
+        line, sizeof(line), "t=%8.3f s  x=%8.4f m  y=%8.4f m  yaw=%8.2f deg  %-11s %2d markers",
+        t_s, s.pose.x_m, s.pose.y_m, s.pose.yaw_rad * kDeg,
+        s.fix == FixState::kCoasting ? "coasting" : std::string(to_string(s.mode)).c_str(),
+        s.markers);
+  } else {
+    n = std::snprintf(line, sizeof(line), "t=%8.3f s  no pose (%s)%*s %2d markers", t_s,
+                      fix_name(s.fix), 36, "", s.markers);
+  }
+  if (s.has_ground_truth && n > 0 && n < static_cast<int>(sizeof(line))) {
+    const Pose2D& g = s.ground_truth;
+    n += std::snprintf(line + n, sizeof(line) - n, "  | truth x=%8.4f y=%8.4f yaw=%8.2f", g.x_m,
+                       g.y_m, g.yaw_rad * kDeg);
+    if (s.valid && n < static_cast<int>(sizeof(line))) {
+      const double err_mm = 1000.0 * std::hypot(s.pose.x_m - g.x_m, s.pose.y_m - g.y_m);
+      const double yaw_err = wrap_angle_rad(s.pose.yaw_rad - g.yaw_rad) * kDeg;
+      n += std::snprintf(line + n, sizeof(line) - n, "  err %6.1f mm %6.2f deg", err_mm, yaw_err);
+    }
+  }
+  if (n > 0 && n < static_cast<int>(sizeof(line)))
+    std::snprintf(line + n, sizeof(line) - n, "  | latency %.2f ms",
+                  static_cast<double>(s.latency_ns) * 1e-6);
+  std::printf("%s\n", line);
+  std::fflush(stdout);
+}
+
+class Service {
+ public:
+  Service(const ServiceConfig& config, const DaemonOptions& options)
+      : config_(config), options_(options) {}
+
+  int run();
+
+ private:
+  int start();
+  void loop();
+  void reload();
+  void shutdown();
+
+  ServiceConfig config_;
+  const DaemonOptions& options_;
+  SignalChannel signals_;  // first: blocks the signals before any thread exists
+  SystemdNotifier notifier_;
+  ProblemCounters problems_;
+  ProgressCounter progress_;
+  std::unique_ptr<capture::CaptureThread> capture_;
+  std::optional<ShmPoseWriter> shm_;
+#ifdef CEILPOSE_DAEMON_HAVE_DDS
+  std::optional<DdsPosePublisher> dds_;
+#endif
+  std::unique_ptr<PipelineWorker> worker_;
+  int exit_code_ = kExitOk;
+  int64_t start_ns_ = 0;
+};
+
+int Service::start() {
+  start_ns_ = monotonic_ns();
+  // 1. Capture: opens the source on its own thread.
+  auto source = capture::make_frame_source(config_.capture.source, source_options(config_));
+  if (!source) {
+    spdlog::error("frame source: {}", source.error().message);
+    return kExitSourceFailure;
+  }
+  capture::CaptureThreadOptions copts;
+  copts.realtime_priority = config_.capture.rt_priority;
+  copts.cpu = config_.capture.cpu;
+  capture_ = std::make_unique<capture::CaptureThread>(std::move(source).value(), copts);
+  if (auto r = capture_->start(); !r) {
+    spdlog::error("frame source {}: {}", config_.capture.source, r.error().message);
+    return kExitSourceFailure;
+  }
+  const capture::RealtimeStatus rt = capture_->realtime();
+  spdlog::info(
+      "capture: {} ({}{}{})", capture_->description(),
+      rt.fifo ? "SCHED_FIFO " + std::to_string(rt.priority) : std::string("normal priority"),
+      rt.pinned ? ", pinned" : "", rt.memory_locked ? ", memory locked" : "");
+
+  // 2. Shared memory.
+  ShmOptions sopts;
+  sopts.name = config_.ipc.shm_name;
+  sopts.group = config_.ipc.group;
+  auto shm = ShmPoseWriter::create(sopts);
+  if (!shm) {
+    spdlog::error("shared memory: {}", shm.error().message);
+    return kExitRuntime;
+  }
+  shm_.emplace(std::move(shm).value());
+
+  // 3. DDS.
+  DdsPosePublisher* dds = nullptr;
+#ifdef CEILPOSE_DAEMON_HAVE_DDS
+  if (config_.dds.enabled) {
+    DdsOptions dopts;
+    dopts.robot = config_.dds.robot_name;
+    if (dopts.robot.empty()) {
+      char host[256] = {};
+      gethostname(host, sizeof(host) - 1);
+      dopts.robot = to_ros_name(host);
+    }
+    dopts.domain.domain_id = static_cast<uint32_t>(config_.dds.domain_id);
+    dopts.domain.interfaces = config_.dds.interfaces;
+    dopts.domain.peers = config_.dds.peers;
+    dopts.reliability = config_.dds.reliable ? ceilpose::DdsReliability::kReliable
+                                             : ceilpose::DdsReliability::kBestEffort;
+    dopts.history_depth = config_.dds.history_depth;
+    auto pub = DdsPosePublisher::create(dopts);
+    if (!pub) {
+      spdlog::error("DDS: {}", pub.error().message);
+      return kExitRuntime;
+    }
+    dds_.emplace(std::move(pub).value());
+    dds = &*dds_;
+    spdlog::info("DDS: domain {} topic {}", dds->domain_id(), dds->pose_topic());
+  }
+#else
+  if (config_.dds.enabled) spdlog::warn("DDS: not built into this ceilposed; shared memory only");
+#endif
+
+  // 4. Pipeline thread.
+  WorkerOptions wopts;
+  wopts.status_interval_ms = config_.watchdog.status_interval_ms;
+  wopts.stall_after_frames = stall_after_frames_from_env();
+  worker_ = std::make_unique<PipelineWorker>(config_, wopts, capture_.get(), &*shm_, dds,
+                                             &problems_, &progress_);
+  worker_->start();
+  spdlog::info("ceilposed running: shared memory {}, positioning {}, filter {}", shm_->name(),
+               to_string(config_.positioning_mode), config_.pipeline.filter.enabled ? "on" : "off");
+  notifier_.ready("running, waiting for the first frame");
+  return kExitOk;
+}
+
+void Service::loop() {
+  const int64_t watchdog_period_ns =
+      notifier_.watchdog_usec() > 0 ? static_cast<int64_t>(notifier_.watchdog_usec()) * 1000 / 2
+                                    : 0;
+  if (watchdog_period_ns > 0)
+    spdlog::info("systemd watchdog: {} ms, fed every {} ms while frames are processed",
+                 notifier_.watchdog_usec() / 1000, watchdog_period_ns / kMsNs);
+  WatchdogGate gate(int64_t{config_.watchdog.max_stall_ms} * kMsNs);
+  const int64_t status_period_ns = int64_t{config_.watchdog.status_interval_ms} * kMsNs;
+  const int64_t problem_period_ns = int64_t{config_.logging.problem_report_interval_ms} * kMsNs;
+  const int64_t end_ns =
+      options_.duration_s > 0 ? start_ns_ + static_cast<int64_t>(options_.duration_s * 1e9) : 0;
+
+  int64_t now = monotonic_ns();
+  int64_t next_watchdog = now;
+  int64_t next_status = now + status_period_ns;
+  int64_t next_problems = now + problem_period_ns;
+  int64_t next_print = now;
+  uint64_t printed_seq = 0;
+  bool stalled_reported = false;
+
+  for (;;) {
+    int64_t next = std::min({next_status, next_problems});
+    if (watchdog_period_ns > 0) next = std::min(next, next_watchdog);
+    if (options_.print_poses) next = std::min(next, next_print);
+    if (end_ns > 0) next = std::min(next, end_ns);
+    const int timeout_ms =
+        static_cast<int>(std::clamp<int64_t>((next - now + kMsNs - 1) / kMsNs, 0, 1000));
+
+    const int sig = signals_.wait(timeout_ms);
+    if (sig == SIGTERM || sig == SIGINT) {
+      spdlog::info("{}: stopping", sig == SIGTERM ? "SIGTERM" : "SIGINT");
+      return;
+    }
+    if (sig == SIGHUP) reload();
+
+    now = monotonic_ns();
+    if (worker_->finished()) {
+      if (capture_->failed()) {
+        spdlog::error("frame source {} failed for good; stopping", capture_->description());
+        exit_code_ = kExitSourceFailure;
+      } else {
+        spdlog::info("frame source {} ended; stopping", capture_->description());
+      }
+      return;
+    }
+    if (end_ns > 0 && now >= end_ns) {
+      spdlog::info("--duration {} s elapsed: stopping", options_.duration_s);
+      return;
+    }
+    if (watchdog_period_ns > 0 && now >= next_watchdog) {
+      next_watchdog = now + watchdog_period_ns;
+      if (gate.may_feed(progress_, now)) {
+        notifier_.watchdog();
+        stalled_reported = false;
+      } else if (!stalled_reported && progress_.count() > 0) {
+        spdlog::error("pipeline made no progress for {} ms: no longer feeding the watchdog",
+                      (now - progress_.last_ns()) / kMsNs);
+        stalled_reported = true;
+      }
+    }
+    if (now >= next_status) {
+      next_status = now + status_period_ns;
+      notifier_.status(status_line(worker_->latest(), worker_->latency()));
+    }
+    if (now >= next_problems) {
+      next_problems = now + problem_period_ns;
+      problems_.report(static_cast<double>(problem_period_ns) * 1e-9);
+    }
+    if (options_.print_poses && now >= next_print) {
+      next_print = now + kPrintPeriodNs;
+      const PoseSnapshot s = worker_->latest();
+      if (s.seq != printed_seq && s.seq != 0) {
+        printed_seq = s.seq;
+        print_pose(s, start_ns_);
+      }
+    }
+  }
+}
+
+void Service::reload() {
+  notifier_.reloading();
+  if (options_.config_path.empty()) {
+    spdlog::warn("SIGHUP: started without --config, nothing to reload");
+    notifier_.reloaded();
+    return;
+  }
+  auto next = resolve_config(options_);
+  if (!next) {
+    spdlog::error("SIGHUP: keeping the running configuration: {}", next.error().message);
+    notifier_.reloaded();
+    return;
+  }
+  const std::vector<std::string> changed = changed_config_keys(config_, *next);
+  std::string applied, needs_restart;
+  bool filter_changed = false;
+  for (const auto& key : changed) {
+    std::string& list = live_key(key) ? applied : needs_restart;
+    list += (list.empty() ? "" : ", ") + key;
+    filter_changed = filter_changed || key.rfind("filter.", 0) == 0;
+  }
+  if (changed.empty()) {
+    spdlog::info("SIGHUP: {} unchanged", options_.config_path);
+  } else {
+    // Copy only the live keys, so the running config stays what really runs.
+    ServiceConfig live = config_;
+    live.pipeline = next->pipeline;
+    live.pipeline.intrinsics.width = config_.pipeline.intrinsics.width;
+    live.pipeline.intrinsics.height = config_.pipeline.intrinsics.height;
+    live.positioning_mode = next->positioning_mode;
+    live.logging = next->logging;
+    if (!applied.empty()) {
+      worker_->reload(live, filter_changed);
+      set_log_level(live.logging.level);
+      spdlog::info("SIGHUP: applied {}", applied);
+    }
+    if (!needs_restart.empty())
+      spdlog::warn("SIGHUP: {} changed but needs a restart (systemctl restart ceilposed)",
+                   needs_restart);
+    config_ = live;
+  }
+  notifier_.reloaded();
+}
+
+void Service::shutdown() {
+  notifier_.stopping();
+  if (worker_) worker_->stop();
+  if (capture_) capture_->stop();
+  if (shm_) shm_->mark_stopped();
+#ifdef CEILPOSE_DAEMON_HAVE_DDS
+  if (dds_) dds_->dispose();
+#endif
+  if (worker_) {
+    const capture::CaptureStats cs = capture_->stats();
+    spdlog::info("stopped after {} frames ({} dropped, {} skipped)", worker_->frames(),
+                 cs.drops + cs.source_drops, cs.skipped);
+    // One journal entry per stage: a multi-line message would lose its prefix.
+    std::istringstream report(worker_->latency().report());
+    for (std::string line; std::getline(report, line);) spdlog::info("latency {}", line);
+  }
+}
+
+int Service::run() {
+  exit_code_ = start();
+  if (exit_code_ == kExitOk) loop();
+  shutdown();
+  return exit_code_;
+}
+
+}  // namespace
+
+int run_service(const ServiceConfig& config, const DaemonOptions& options) {
+  Service service(config, options);
+  return service.run();
+}
+
+}  // namespace ceilpose::daemon
