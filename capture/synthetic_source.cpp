@@ -1,0 +1,91 @@
+#include "capture/synthetic_source.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+
+#include "capture/wait.h"
+#include "core/clock.h"
+#include "sim/trajectory.h"
+
+namespace ceilpose::capture {
+
+SyntheticSource::SyntheticSource(SourceOptions options) : options_(std::move(options)) {}
+
+SyntheticSource::~SyntheticSource() = default;
+
+std::string SyntheticSource::describe() const {
+  char text[160];
+  std::snprintf(text, sizeof text, "synthetic %dx%d %.1f fps, seed %llu", options_.intrinsics.width,
+                options_.intrinsics.height, options_.fps,
+                static_cast<unsigned long long>(options_.seed));
+  return text;
+}
+
+Result<void> SyntheticSource::do_open() {
+  if (!(options_.fps > 0.0) || options_.fps > 10000.0) {
+    return make_error("synthetic: frame rate must be in (0, 10000] fps, got " +
+                      std::to_string(options_.fps));
+  }
+  const auto& k = options_.intrinsics;
+  if (k.width <= 0 || k.height <= 0) {
+    return make_error("synthetic: camera size must be positive, got " + std::to_string(k.width) +
+                      "x" + std::to_string(k.height));
+  }
+  renderer_.emplace(sim::SceneOptions{options_.layout, k, options_.seed});
+  pool_.resize(std::max(2, options_.buffer_count), k.width, k.height, PixelFormat::kRgb24);
+  period_ns_ = static_cast<int64_t>(std::llround(1e9 / options_.fps));
+  return {};
+}
+
+Result<void> SyntheticSource::do_start() {
+  start_ns_ = monotonic_ns();
+  tick_ = 0;
+  return {};
+}
+
+NextStatus SyntheticSource::do_next(Frame* out, int timeout_ms) {
+  const int64_t now_ns = monotonic_ns();
+  int64_t due_ns = start_ns_ + static_cast<int64_t>(tick_) * period_ns_;
+  if (now_ns - due_ns >= period_ns_) {
+    // Behind by whole frames: those exposures never happened; resume at the
+    // most recent tick.
+    const uint64_t current = static_cast<uint64_t>((now_ns - start_ns_) / period_ns_);
+    stats_.drops += current - tick_;
+    tick_ = current;
+    due_ns = start_ns_ + static_cast<int64_t>(tick_) * period_ns_;
+  }
+  const int64_t deadline_ns = now_ns + static_cast<int64_t>(timeout_ms) * 1'000'000;
+  if (due_ns > deadline_ns) {
+    sleep_until_ns(deadline_ns);
+    return NextStatus::kTimeout;
+  }
+  sleep_until_ns(due_ns);
+  const uint64_t tick = tick_++;
+  int32_t slot = -1;
+  Image* image = pool_.acquire(&slot);
+  if (image == nullptr) {
+    ++stats_.drops;  // every slot held downstream, like a camera with no free buffer
+    return NextStatus::kTimeout;
+  }
+  const double t_s = options_.trajectory_start_s + static_cast<double>(due_ns - start_ns_) * 1e-9;
+  const Pose2D pose = sim::trajectory_pose(options_.layout, t_s);
+  renderer_->render(pose, options_.mount, options_.effects, options_.seed * 1'000'003 + tick,
+                    image);
+  Frame f;
+  f.image = image->view();
+  f.capture_ns = due_ns;
+  f.dequeue_ns = monotonic_ns();
+  f.source_timestamp_ns = due_ns;
+  f.sequence = sequence_++;
+  f.has_ground_truth = true;
+  f.ground_truth = pose;
+  f.buffer_index = slot;
+  ++stats_.frames;
+  *out = f;
+  return NextStatus::kFrame;
+}
+
+void SyntheticSource::do_release(const Frame& frame) { pool_.release(frame.buffer_index); }
+
+}  // namespace ceilpose::capture
