@@ -1,0 +1,92 @@
+#include "ipc/dds/dds_messages.h"
+
+#include <cmath>
+
+namespace ceilpose {
+namespace {
+
+constexpr int64_t kNsPerS = 1'000'000'000;
+
+// ROS 2's Time is (int32 sec, uint32 nanosec) with nanosec in [0, 1e9):
+// floor division keeps that true for times before the epoch too.
+builtin_interfaces_msg_dds__Time_ to_time(int64_t realtime_ns) {
+  int64_t sec = realtime_ns / kNsPerS;
+  int64_t nsec = realtime_ns % kNsPerS;
+  if (nsec < 0) {
+    nsec += kNsPerS;
+    sec -= 1;
+  }
+  return {static_cast<int32_t>(sec), static_cast<uint32_t>(nsec)};
+}
+
+// Row/column of x, y and rotation about z in ROS's 6x6 pose covariance
+// (x, y, z, rot_x, rot_y, rot_z).
+constexpr std::array<int, 3> kPlanarIndex{0, 1, 5};
+
+}  // namespace
+
+void to_message(const DdsPose& pose, geometry_msgs_msg_dds__PoseWithCovarianceStamped_* msg) {
+  msg->header.stamp = to_time(pose.capture_realtime_ns);
+  // Cyclone only reads the string during dds_write; the cast drops a const
+  // the generated C struct cannot express.
+  msg->header.frame_id = const_cast<char*>(kMapFrame);
+  auto& p = msg->pose.pose;
+  p.position.x = pose.pose.x_m;
+  p.position.y = pose.pose.y_m;
+  p.position.z = 0.0;
+  // Rotation by yaw about +z: q = (0, 0, sin(yaw/2), cos(yaw/2)).
+  p.orientation.x = 0.0;
+  p.orientation.y = 0.0;
+  p.orientation.z = std::sin(0.5 * pose.pose.yaw_rad);
+  p.orientation.w = std::cos(0.5 * pose.pose.yaw_rad);
+  // The 3x3 (x, y, yaw) block goes to rows/columns (0, 1, 5) of the 6x6;
+  // z, roll and pitch are unobserved: large variance, no correlation.
+  auto& c = msg->pose.covariance;
+  for (double& v : c) v = 0.0;
+  c[2 * 6 + 2] = kUnobservedVariance;
+  c[3 * 6 + 3] = kUnobservedVariance;
+  c[4 * 6 + 4] = kUnobservedVariance;
+  for (int r = 0; r < 3; ++r) {
+    for (int k = 0; k < 3; ++k) {
+      c[kPlanarIndex[r] * 6 + kPlanarIndex[k]] = pose.covariance[r * 3 + k];
+    }
+  }
+}
+
+DdsPose from_message(const geometry_msgs_msg_dds__PoseWithCovarianceStamped_& msg) {
+  DdsPose out;
+  out.valid = true;
+  out.capture_realtime_ns =
+      static_cast<int64_t>(msg.header.stamp.sec) * kNsPerS + msg.header.stamp.nanosec;
+  const auto& p = msg.pose.pose;
+  out.pose.x_m = p.position.x;
+  out.pose.y_m = p.position.y;
+  const auto& q = p.orientation;
+  // Yaw of a general quaternion (z-y-x Euler); equals 2*atan2(z, w) for a pure yaw.
+  out.pose.yaw_rad = std::atan2(2.0 * (q.w * q.z + q.x * q.y), 1.0 - 2.0 * (q.y * q.y + q.z * q.z));
+  for (int r = 0; r < 3; ++r) {
+    for (int k = 0; k < 3; ++k) {
+      out.covariance[r * 3 + k] = msg.pose.covariance[kPlanarIndex[r] * 6 + kPlanarIndex[k]];
+    }
+  }
+  return out;
+}
+
+void to_message(const DdsStatus& status, const std::string& robot, ceilpose_msg_dds__Status_* msg) {
+  msg->header.stamp = to_time(status.publish_realtime_ns);
+  msg->header.frame_id = const_cast<char*>(kMapFrame);
+  msg->robot = const_cast<char*>(robot.c_str());
+  msg->health = static_cast<uint8_t>(status.health);
+  msg->fix = status.fix;
+  msg->mode = status.mode;
+  msg->markers = status.markers;
+  msg->fps = status.fps;
+  msg->frames = status.frames;
+  msg->drops = status.drops;
+  msg->latency_p50_us = status.latency_p50_us;
+  msg->latency_p90_us = status.latency_p90_us;
+  msg->latency_p99_us = status.latency_p99_us;
+  msg->latency_max_us = status.latency_max_us;
+}
+
+}  // namespace ceilpose

@@ -1,0 +1,131 @@
+#include "ipc/dds/dds_options.h"
+
+#include <cctype>
+
+namespace ceilpose {
+namespace {
+
+// Cyclone 0.10 refuses domain ids above 230 (the port mapping would overflow).
+constexpr uint32_t kMaxDomainId = 230;
+
+bool is_alpha(char c) { return std::isalpha(static_cast<unsigned char>(c)) != 0; }
+bool is_alnum(char c) { return std::isalnum(static_cast<unsigned char>(c)) != 0; }
+
+// Interface names and peer addresses are pasted into XML attributes; rather
+// than escape, refuse what no interface name or address contains.
+bool is_plain_xml_value(std::string_view value) {
+  if (value.empty()) return false;
+  for (char c : value) {
+    if (c == '<' || c == '>' || c == '&' || c == '"' || c == '\'' || c == ',' ||
+        std::isspace(static_cast<unsigned char>(c)) != 0) {
+      return false;
+    }
+  }
+  return true;
+}
+
+}  // namespace
+
+bool is_valid_ros_name(std::string_view name) {
+  if (name.empty() || !(is_alpha(name[0]) || name[0] == '_')) return false;
+  for (size_t k = 0; k < name.size(); ++k) {
+    const char c = name[k];
+    if (!(is_alnum(c) || c == '_')) return false;
+    if (c == '_' && k + 1 < name.size() && name[k + 1] == '_') return false;
+  }
+  return true;
+}
+
+std::string to_ros_name(std::string_view text) {
+  std::string out;
+  for (char c : text) {
+    const char mapped = is_alnum(c) ? c : '_';
+    if (mapped == '_' && !out.empty() && out.back() == '_') continue;
+    out.push_back(mapped);
+  }
+  if (!out.empty() && std::isdigit(static_cast<unsigned char>(out[0])) != 0) {
+    out.insert(out.begin(), 'r');
+  }
+  return out;
+}
+
+std::string pose_topic_name(std::string_view robot) { return "rt/" + std::string(robot) + "/pose"; }
+
+std::string status_topic_name(std::string_view robot) {
+  return "rt/" + std::string(robot) + "/ceilpose_status";
+}
+
+std::string robot_from_pose_topic(std::string_view topic) {
+  constexpr std::string_view kPrefix = "rt/";
+  constexpr std::string_view kSuffix = "/pose";
+  if (topic.size() <= kPrefix.size() + kSuffix.size() || !topic.starts_with(kPrefix) ||
+      !topic.ends_with(kSuffix)) {
+    return {};
+  }
+  const std::string_view robot =
+      topic.substr(kPrefix.size(), topic.size() - kPrefix.size() - kSuffix.size());
+  return is_valid_ros_name(robot) ? std::string(robot) : std::string();
+}
+
+Result<void> validate(const DdsDomainOptions& options) {
+  if (options.domain_id > kMaxDomainId) {
+    return make_error("DDS domain id " + std::to_string(options.domain_id) +
+                      " is out of range 0.." + std::to_string(kMaxDomainId));
+  }
+  for (const auto& name : options.interfaces) {
+    if (!is_plain_xml_value(name)) {
+      return make_error("DDS network interface '" + name + "' is not a valid interface name");
+    }
+  }
+  for (const auto& peer : options.peers) {
+    if (!is_plain_xml_value(peer)) {
+      return make_error("DDS peer '" + peer + "' is not a valid address");
+    }
+  }
+  return {};
+}
+
+Result<void> validate(const DdsOptions& options) {
+  if (!is_valid_ros_name(options.robot)) {
+    return make_error("robot name '" + options.robot +
+                      "' is not a legal ROS name (letters, digits and single '_', not starting "
+                      "with a digit); e.g. '" +
+                      to_ros_name(options.robot) + "'");
+  }
+  if (options.history_depth < 1) {
+    return make_error("DDS history depth " + std::to_string(options.history_depth) +
+                      " must be at least 1");
+  }
+  return validate(options.domain);
+}
+
+std::string cyclone_config_xml(const DdsDomainOptions& options) {
+  std::string xml = "<CycloneDDS><Domain id=\"any\"><General>";
+  if (!options.interfaces.empty()) {
+    xml += "<Interfaces>";
+    for (const auto& name : options.interfaces) {
+      // Cyclone matches an address or a name given as `name` or `address`;
+      // a leading digit means the user gave an address.
+      const bool is_address = std::isdigit(static_cast<unsigned char>(name[0])) != 0;
+      xml += is_address ? "<NetworkInterface address=\"" : "<NetworkInterface name=\"";
+      xml += name + "\"/>";
+    }
+    xml += "</Interfaces>";
+  }
+  if (options.allow_multicast.has_value()) {
+    xml += *options.allow_multicast ? "<AllowMulticast>default</AllowMulticast>"
+                                    : "<AllowMulticast>false</AllowMulticast>";
+  }
+  xml += "</General>";
+  if (!options.peers.empty()) {
+    // Unicast discovery reaches a peer's participants through the ports of
+    // their participant indices, so each participant needs one.
+    xml += "<Discovery><ParticipantIndex>auto</ParticipantIndex><Peers>";
+    for (const auto& peer : options.peers) xml += "<Peer address=\"" + peer + "\"/>";
+    xml += "</Peers></Discovery>";
+  }
+  xml += "</Domain></CycloneDDS>";
+  return xml;
+}
+
+}  // namespace ceilpose

@@ -1,0 +1,66 @@
+#pragma once
+// What a DDS participant of ceilpose needs to know: domain, network, QoS and
+// the robot name that becomes the ROS namespace of its topics.
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "core/result.h"
+
+namespace ceilpose {
+
+// Where the participant lives. With no interfaces, peers or multicast choice
+// Cyclone reads its configuration from CYCLONEDDS_URI as usual; otherwise
+// ceilpose creates the domain itself from these options alone (CYCLONEDDS_URI
+// is then not read for this domain).
+struct DdsDomainOptions {
+  uint32_t domain_id = 0;               // SPEC §7: --domain, default 0; Cyclone allows 0..230
+  std::vector<std::string> interfaces;  // network interface names or addresses, e.g. "eth0", "lo"
+  std::vector<std::string> peers;       // unicast discovery peers, e.g. "10.0.0.7", "127.0.0.1"
+  // Unset keeps Cyclone's default.
+  std::optional<bool> allow_multicast;
+
+  bool needs_explicit_domain() const {
+    return !interfaces.empty() || !peers.empty() || allow_multicast.has_value();
+  }
+};
+
+enum class DdsReliability : uint8_t { kReliable, kBestEffort };
+
+struct DdsOptions {
+  // ROS name token: the namespace of the topics rt/<robot>/pose and
+  // rt/<robot>/ceilpose_status. Must satisfy is_valid_ros_name().
+  std::string robot;
+  DdsDomainOptions domain;
+  // ROS 2's default profile is reliable, keep-last 10, volatile; a reliable
+  // writer serves both reliable and best-effort readers, the reverse is not true.
+  DdsReliability reliability = DdsReliability::kReliable;
+  int32_t history_depth = 10;  // keep-last depth of the writers, >= 1
+};
+
+// A legal single-token ROS 2 name (rmw_validate_namespace's rules for one
+// token): [A-Za-z_][A-Za-z0-9_]*, without repeated underscores.
+bool is_valid_ros_name(std::string_view name);
+
+// Replaces every character a ROS name token may not hold ('-', '.', ...) with
+// '_' (collapsing runs) and prefixes 'r' to a leading digit: host names such as "robot-7" then
+// become usable robot names ("robot_7"). Empty input yields empty output.
+std::string to_ros_name(std::string_view text);
+
+std::string pose_topic_name(std::string_view robot);    // "rt/<robot>/pose"
+std::string status_topic_name(std::string_view robot);  // "rt/<robot>/ceilpose_status"
+
+// For a DDS topic name of the form rt/<robot>/pose returns <robot>, else empty.
+std::string robot_from_pose_topic(std::string_view topic);
+
+// Checks ranges and names, the messages naming the offending option.
+Result<void> validate(const DdsDomainOptions& options);
+Result<void> validate(const DdsOptions& options);
+
+// The Cyclone XML fragment for the explicit settings of `options`
+// (<CycloneDDS><Domain id="any">...), valid for dds_create_domain.
+std::string cyclone_config_xml(const DdsDomainOptions& options);
+
+}  // namespace ceilpose

@@ -1,0 +1,94 @@
+#include "ipc/dds/dds_pose_publisher.h"
+
+#include "ipc/dds/dds_error.h"
+#include "ipc/dds/dds_qos.h"
+
+namespace ceilpose {
+namespace {
+
+// A reliable writer whose readers stall blocks at most this long in
+// dds_write before reporting a timeout: a late pose is worth less than the
+// next frame.
+constexpr int64_t kMaxBlockingMs = 10;
+
+Result<dds_entity_t> create_writer(const DdsParticipant& participant,
+                                   const dds_topic_descriptor_t* descriptor,
+                                   const std::string& topic_name, const DdsOptions& options) {
+  const std::string where =
+      "DDS topic " + topic_name + " on domain " + std::to_string(participant.domain_id());
+  const dds_entity_t topic =
+      dds_create_topic(participant.handle(), descriptor, topic_name.c_str(), nullptr, nullptr);
+  if (topic < 0) return dds_error("cannot create " + where, topic);
+
+  DdsQos qos = make_dds_qos();
+  if (options.reliability == DdsReliability::kReliable) {
+    dds_qset_reliability(qos.get(), DDS_RELIABILITY_RELIABLE, DDS_MSECS(kMaxBlockingMs));
+  } else {
+    dds_qset_reliability(qos.get(), DDS_RELIABILITY_BEST_EFFORT, 0);
+  }
+  dds_qset_history(qos.get(), DDS_HISTORY_KEEP_LAST, options.history_depth);
+  dds_qset_durability(qos.get(), DDS_DURABILITY_VOLATILE);
+  // ROS 2 Humble/Iron and other vendors' ROS readers only speak XCDR1
+  // (PLAIN_CDR); say so explicitly rather than rely on Cyclone's choice.
+  const dds_data_representation_id_t xcdr1 = DDS_DATA_REPRESENTATION_XCDR1;
+  dds_qset_data_representation(qos.get(), 1, &xcdr1);
+  const dds_entity_t writer = dds_create_writer(participant.handle(), topic, qos.get(), nullptr);
+  if (writer < 0) return dds_error("cannot create a writer for " + where, writer);
+  return writer;
+}
+
+}  // namespace
+
+Result<DdsPosePublisher> DdsPosePublisher::create(const DdsOptions& options) {
+  if (auto ok = validate(options); !ok) return ok.error();
+  auto participant = DdsParticipant::create(options.domain);
+  if (!participant) return participant.error();
+
+  DdsPosePublisher pub;
+  pub.participant_ = std::move(participant.value());
+  pub.robot_ = options.robot;
+  pub.pose_topic_ = pose_topic_name(options.robot);
+  pub.status_topic_ = status_topic_name(options.robot);
+
+  auto pose_writer =
+      create_writer(pub.participant_, &geometry_msgs_msg_dds__PoseWithCovarianceStamped__desc,
+                    pub.pose_topic_, options);
+  if (!pose_writer) return pose_writer.error();
+  pub.pose_writer_ = *pose_writer;
+  auto status_writer =
+      create_writer(pub.participant_, &ceilpose_msg_dds__Status__desc, pub.status_topic_, options);
+  if (!status_writer) return status_writer.error();
+  pub.status_writer_ = *status_writer;
+  return pub;
+}
+
+Result<void> DdsPosePublisher::publish(const DdsPose& pose) {
+  if (!participant_.valid()) return make_error("DDS publisher of " + robot_ + " was disposed");
+  if (!pose.valid) {
+    ++skipped_invalid_;
+    return {};
+  }
+  geometry_msgs_msg_dds__PoseWithCovarianceStamped_ msg;
+  to_message(pose, &msg);
+  const dds_return_t rc = dds_write(pose_writer_, &msg);
+  if (rc != DDS_RETCODE_OK) return dds_error("cannot write a pose to " + pose_topic_, rc);
+  ++published_;
+  return {};
+}
+
+Result<void> DdsPosePublisher::publish_status(const DdsStatus& status) {
+  if (!participant_.valid()) return make_error("DDS publisher of " + robot_ + " was disposed");
+  ceilpose_msg_dds__Status_ msg;
+  to_message(status, robot_, &msg);
+  const dds_return_t rc = dds_write(status_writer_, &msg);
+  if (rc != DDS_RETCODE_OK) return dds_error("cannot write a status to " + status_topic_, rc);
+  return {};
+}
+
+void DdsPosePublisher::dispose() {
+  participant_.reset();
+  pose_writer_ = 0;
+  status_writer_ = 0;
+}
+
+}  // namespace ceilpose

@@ -1,0 +1,59 @@
+#pragma once
+// Publishes a robot's poses as ROS 2 geometry_msgs/msg/PoseWithCovarianceStamped
+// on rt/<robot>/pose (ROS topic /<robot>/pose) and its health as
+// ceilpose/msg/Status on rt/<robot>/ceilpose_status, both XCDR1 as ROS 2
+// Humble/Iron expect.
+//
+// Lifecycle: create() builds participant -> topics -> writers and fails with
+// a message naming the step; publish()/publish_status() write; dispose() (or
+// the destructor) leaves the domain. Move-only. One thread at a time.
+#include <dds/dds.h>
+
+#include <cstdint>
+#include <string>
+
+#include "core/result.h"
+#include "ipc/dds/dds_messages.h"
+#include "ipc/dds/dds_options.h"
+#include "ipc/dds/dds_participant.h"
+
+namespace ceilpose {
+
+class DdsPosePublisher {
+ public:
+  static Result<DdsPosePublisher> create(const DdsOptions& options);
+
+  DdsPosePublisher(DdsPosePublisher&&) noexcept = default;
+  DdsPosePublisher& operator=(DdsPosePublisher&&) noexcept = default;
+
+  // Per-frame path: no allocation on success. An invalid pose is not
+  // published (ROS consumers would take any pose on the topic as a fix); it
+  // is counted in skipped_invalid() and the status topic reports no fix.
+  Result<void> publish(const DdsPose& pose);
+  Result<void> publish_status(const DdsStatus& status);
+
+  // Leaves the domain now: remote readers see the writers go. Idempotent;
+  // publishing afterwards fails.
+  void dispose();
+
+  const std::string& robot() const { return robot_; }
+  const std::string& pose_topic() const { return pose_topic_; }
+  const std::string& status_topic() const { return status_topic_; }
+  uint32_t domain_id() const { return participant_.domain_id(); }
+  uint64_t published() const { return published_; }
+  uint64_t skipped_invalid() const { return skipped_invalid_; }
+
+ private:
+  DdsPosePublisher() = default;
+
+  DdsParticipant participant_;
+  dds_entity_t pose_writer_ = 0;  // children of participant_: deleted with it
+  dds_entity_t status_writer_ = 0;
+  std::string robot_;
+  std::string pose_topic_;
+  std::string status_topic_;
+  uint64_t published_ = 0;
+  uint64_t skipped_invalid_ = 0;
+};
+
+}  // namespace ceilpose
