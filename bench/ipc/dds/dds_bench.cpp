@@ -1,0 +1,371 @@
+// DDS publish -> receive latency on loopback between two processes, beside
+// Cyclone's own ddsperf ping/pong on the same configuration (issue 5, Speed).
+//
+// A child `dds_bench --pong DOMAIN` echoes every pose it receives through its
+// own DdsPosePublisher, from Cyclone's receive thread (a data-available
+// listener), as `ddsperf pong` does.
+//  - BM_DdsPoseRoundTrip: this process publishes through DdsPosePublisher and
+//    sends the next ping from its listener as soon as the echo arrives, like
+//    `ddsperf ping`; one iteration = kBatch round trips.
+//  - BM_DdsPoseRoundTripWaitset: the same, but an application thread blocks
+//    in a waitset for each echo (one iteration = one round trip), as a
+//    consumer thread would: adds a thread wake-up per echo.
+//  - BM_DdsperfRoundTrip: `ddsperf -D 5 ping` against `ddsperf pong` on the
+//    same configuration, percentiles parsed from its output, and the ratios
+//    of BM_DdsPoseRoundTrip's figures to it (target <= 1.5).
+#include <benchmark/benchmark.h>
+#include <dds/dds.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <chrono>
+#include <condition_variable>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <mutex>
+#include <regex>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "core/clock.h"
+#include "ipc/dds/dds_pose_publisher.h"
+#include "tests/ipc/dds/child_process.h"
+#include "tests/ipc/dds/dds_test_env.h"
+
+namespace ceilpose {
+namespace {
+
+constexpr int64_t kMatchTimeoutMs = 20'000;
+constexpr int64_t kEchoTimeoutMs = 2'000;
+constexpr size_t kBatch = 1000;  // round trips per iteration of the listener benchmark
+// The domain is private to this run, so the names need not be.
+constexpr char kPingRobot[] = "bench_ping";
+constexpr char kPongRobot[] = "bench_pong";
+
+// Round-trip percentiles of BM_DdsPoseRoundTrip, kept for the ratio printed
+// by the ddsperf benchmark that runs after it.
+double g_ours_p50_us = 0.0;
+double g_ours_p99_us = 0.0;
+
+double percentile(std::vector<double> v, double q) {
+  if (v.empty()) return 0.0;
+  const auto k = static_cast<size_t>(q * static_cast<double>(v.size() - 1) + 0.5);
+  std::nth_element(v.begin(), v.begin() + static_cast<ptrdiff_t>(k), v.end());
+  return v[k];
+}
+
+struct WindowPercentiles {
+  std::vector<double> p50_us, p99_us;
+};
+
+// Percentiles per one-second window of send times: the statistic ddsperf
+// prints, so that the two can be compared like for like (the median over the
+// windows damps a second in which another process held the CPU).
+WindowPercentiles per_second_percentiles(const std::vector<int64_t>& sent_at_ns,
+                                         const std::vector<double>& rtt_us) {
+  WindowPercentiles out;
+  size_t begin = 0;
+  while (begin < rtt_us.size()) {
+    size_t end = begin;
+    while (end < rtt_us.size() && sent_at_ns[end] - sent_at_ns[begin] < 1'000'000'000) ++end;
+    const std::vector<double> window(rtt_us.begin() + static_cast<ptrdiff_t>(begin),
+                                     rtt_us.begin() + static_cast<ptrdiff_t>(end));
+    if (window.size() >= 100) {  // skip a short tail window
+      out.p50_us.push_back(percentile(window, 0.50));
+      out.p99_us.push_back(percentile(window, 0.99));
+    }
+    begin = end;
+  }
+  return out;
+}
+
+DdsOptions bench_options(const char* robot, uint32_t domain_id) {
+  DdsOptions o;
+  o.robot = robot;
+  o.domain.domain_id = domain_id;
+  return o;
+}
+
+// A reliable reader of rt/<robot>/pose, with a data-available listener when
+// `on_data` is given, else with a waitset to block on.
+class PoseReader {
+ public:
+  PoseReader(dds_entity_t participant, const char* robot, dds_on_data_available_fn on_data,
+             void* arg) {
+    topic_ = dds_create_topic(participant, &geometry_msgs_msg_dds__PoseWithCovarianceStamped__desc,
+                              pose_topic_name(robot).c_str(), nullptr, nullptr);
+    dds_qos_t* qos = dds_create_qos();
+    dds_qset_reliability(qos, DDS_RELIABILITY_RELIABLE, DDS_SECS(1));
+    dds_qset_history(qos, DDS_HISTORY_KEEP_LAST, 10);
+    dds_listener_t* listener = nullptr;
+    if (on_data != nullptr) {
+      listener = dds_create_listener(arg);
+      dds_lset_data_available(listener, on_data);
+    }
+    reader_ = dds_create_reader(participant, topic_, qos, listener);
+    dds_delete_qos(qos);
+    if (listener != nullptr) dds_delete_listener(listener);
+    cond_ = dds_create_readcondition(reader_, DDS_ANY_STATE);
+    waitset_ = dds_create_waitset(participant);
+    dds_waitset_attach(waitset_, cond_, 0);
+  }
+  bool ok() const { return topic_ > 0 && reader_ > 0 && cond_ > 0 && waitset_ > 0; }
+
+  // Takes one sample without blocking.
+  static bool take_now(dds_entity_t reader, geometry_msgs_msg_dds__PoseWithCovarianceStamped_* msg,
+                       DdsPose* pose) {
+    void* samples[1] = {msg};
+    dds_sample_info_t info;
+    if (dds_take(reader, samples, &info, 1, 1) != 1 || !info.valid_data) return false;
+    *pose = from_message(*msg);
+    return true;
+  }
+
+  // Blocks up to timeout_ms for the next sample.
+  bool take(int64_t timeout_ms, DdsPose* pose) {
+    const int64_t deadline_ns = monotonic_ns() + timeout_ms * 1'000'000;
+    for (;;) {
+      if (take_now(cond_, &msg_, pose)) return true;
+      const int64_t left_ns = deadline_ns - monotonic_ns();
+      if (left_ns <= 0) return false;
+      dds_waitset_wait(waitset_, nullptr, 0, left_ns);
+    }
+  }
+
+ private:
+  dds_entity_t topic_ = 0, reader_ = 0, cond_ = 0, waitset_ = 0;
+  geometry_msgs_msg_dds__PoseWithCovarianceStamped_ msg_{};
+};
+
+// --- pong process ----------------------------------------------------------
+
+struct Pong {
+  DdsPosePublisher* pub = nullptr;
+  geometry_msgs_msg_dds__PoseWithCovarianceStamped_ msg{};
+};
+
+void pong_on_data(dds_entity_t reader, void* arg) {
+  auto* pong = static_cast<Pong*>(arg);
+  DdsPose pose;
+  while (PoseReader::take_now(reader, &pong->msg, &pose)) (void)pong->pub->publish(pose);
+}
+
+int run_pong(uint32_t domain_id) {
+  auto pub = DdsPosePublisher::create(bench_options(kPongRobot, domain_id));
+  auto rp = DdsParticipant::create(bench_options(kPingRobot, domain_id).domain);
+  if (!pub || !rp) {
+    std::fprintf(stderr, "dds_bench --pong: %s\n",
+                 (!pub ? pub.error() : rp.error()).message.c_str());
+    return 1;
+  }
+  Pong pong;
+  pong.pub = &*pub;
+  PoseReader reader(rp->handle(), kPingRobot, &pong_on_data, &pong);
+  if (!reader.ok()) return 1;
+  std::printf("ready\n");
+  std::fflush(stdout);
+  // Echoes happen on Cyclone's thread; live as long as the benchmark does.
+  const pid_t parent = getppid();
+  while (getppid() == parent) sleep(1);
+  return 0;
+}
+
+// --- ping side ---------------------------------------------------------------
+
+class PongProcess {
+ public:
+  explicit PongProcess(uint32_t domain_id)
+      : child_({"/proc/self/exe", "--pong", std::to_string(domain_id)}) {}
+  bool ready() {
+    return child_.read_until("ready", kMatchTimeoutMs).find("ready") != std::string::npos;
+  }
+
+ private:
+  test::ChildProcess child_;
+};
+
+// Round trips driven from the listener: each echo sends the next ping.
+struct PingChain {
+  DdsPosePublisher* pub = nullptr;
+  geometry_msgs_msg_dds__PoseWithCovarianceStamped_ msg{};
+  std::mutex m;
+  std::condition_variable cv;
+  DdsPose ping;
+  int64_t sent_ns = 0;
+  size_t target = 0;
+  std::vector<double> rtt_us;
+  std::vector<int64_t> sent_at_ns;  // per round trip, for per-second windows
+
+  void send_next_locked() {
+    ping.pose.x_m += 1.0;  // sequence number: echoes of older pings are ignored
+    sent_ns = monotonic_ns();
+    (void)pub->publish(ping);
+  }
+
+  // Runs n more round trips; false if the chain stalled (echo lost).
+  bool run(size_t n, int64_t timeout_ms) {
+    std::unique_lock lock(m);
+    target = rtt_us.size() + n;
+    send_next_locked();
+    return cv.wait_for(lock, std::chrono::milliseconds(timeout_ms),
+                       [&] { return rtt_us.size() >= target; });
+  }
+};
+
+void ping_on_data(dds_entity_t reader, void* arg) {
+  auto* chain = static_cast<PingChain*>(arg);
+  DdsPose echo;
+  while (PoseReader::take_now(reader, &chain->msg, &echo)) {
+    const int64_t now_ns = monotonic_ns();
+    std::lock_guard lock(chain->m);
+    if (echo.pose.x_m != chain->ping.pose.x_m || chain->rtt_us.size() >= chain->target) continue;
+    chain->rtt_us.push_back(static_cast<double>(now_ns - chain->sent_ns) / 1e3);
+    chain->sent_at_ns.push_back(chain->sent_ns);
+    if (chain->rtt_us.size() < chain->target) {
+      chain->send_next_locked();
+    } else {
+      chain->cv.notify_one();
+    }
+  }
+}
+
+void BM_DdsPoseRoundTrip(benchmark::State& state) {
+  const uint32_t domain_id = test::unique_domain_id();
+  PongProcess pong(domain_id);
+  if (!pong.ready()) return state.SkipWithError("pong process did not start");
+  auto pub = DdsPosePublisher::create(bench_options(kPingRobot, domain_id));
+  auto rp = DdsParticipant::create(bench_options(kPongRobot, domain_id).domain);
+  if (!pub || !rp) return state.SkipWithError("cannot create DDS entities");
+  PingChain chain;
+  chain.pub = &*pub;
+  chain.ping.valid = true;
+  chain.rtt_us.reserve(1 << 22);
+  chain.sent_at_ns.reserve(1 << 22);
+  PoseReader reader(rp->handle(), kPongRobot, &ping_on_data, &chain);
+  // Discovery: a reliable writer drops what it writes before it has matched
+  // the pong's reader, so ping until an echo comes back.
+  const int64_t match_deadline_ns = monotonic_ns() + kMatchTimeoutMs * 1'000'000;
+  bool matched = false;
+  while (!matched && monotonic_ns() < match_deadline_ns) matched = chain.run(1, 50);
+  if (!matched || !chain.run(kBatch, kEchoTimeoutMs)) {
+    return state.SkipWithError("no echo from the pong process");
+  }
+  {
+    std::lock_guard lock(chain.m);
+    chain.rtt_us.clear();  // matching and warm-up
+    chain.sent_at_ns.clear();
+    chain.target = 0;
+  }
+  for (auto _ : state) {
+    if (!chain.run(kBatch, kEchoTimeoutMs)) return state.SkipWithError("echo lost");
+  }
+  std::lock_guard lock(chain.m);
+  const auto windows = per_second_percentiles(chain.sent_at_ns, chain.rtt_us);
+  g_ours_p50_us = percentile(windows.p50_us, 0.5);
+  g_ours_p99_us = percentile(windows.p99_us, 0.5);
+  state.counters["rtt_p50_us"] = percentile(chain.rtt_us, 0.50);
+  state.counters["rtt_p99_us"] = percentile(chain.rtt_us, 0.99);
+  state.counters["rtt_p50_us_1s_median"] = g_ours_p50_us;
+  state.counters["rtt_p99_us_1s_median"] = g_ours_p99_us;
+  state.counters["round_trips"] = static_cast<double>(chain.rtt_us.size());
+  state.counters["payload_bytes"] = 364;
+}
+BENCHMARK(BM_DdsPoseRoundTrip)->MinTime(5.0)->Unit(benchmark::kMillisecond)->UseRealTime();
+
+void BM_DdsPoseRoundTripWaitset(benchmark::State& state) {
+  const uint32_t domain_id = test::unique_domain_id();
+  PongProcess pong(domain_id);
+  if (!pong.ready()) return state.SkipWithError("pong process did not start");
+  auto pub = DdsPosePublisher::create(bench_options(kPingRobot, domain_id));
+  auto rp = DdsParticipant::create(bench_options(kPongRobot, domain_id).domain);
+  if (!pub || !rp) return state.SkipWithError("cannot create DDS entities");
+  PoseReader reader(rp->handle(), kPongRobot, nullptr, nullptr);
+  DdsPose ping;
+  ping.valid = true;
+  DdsPose echo;
+  const int64_t match_deadline_ns = monotonic_ns() + kMatchTimeoutMs * 1'000'000;
+  bool matched = false;
+  while (!matched && monotonic_ns() < match_deadline_ns) {
+    (void)pub->publish(ping);
+    matched = reader.take(50, &echo);
+  }
+  if (!matched) return state.SkipWithError("no echo from the pong process");
+  while (reader.take(100, &echo)) {
+  }  // drain the echoes of the discovery pings
+
+  std::vector<double> rtt_us;
+  rtt_us.reserve(1 << 22);
+  for (auto _ : state) {
+    ping.pose.x_m += 1.0;
+    const int64_t t0 = monotonic_ns();
+    if (auto ok = pub->publish(ping); !ok) return state.SkipWithError(ok.error().message.c_str());
+    if (!reader.take(kEchoTimeoutMs, &echo) || echo.pose.x_m != ping.pose.x_m) {
+      return state.SkipWithError("echo lost or out of order");
+    }
+    rtt_us.push_back(static_cast<double>(monotonic_ns() - t0) / 1e3);
+  }
+  state.counters["rtt_p50_us"] = percentile(rtt_us, 0.50);
+  state.counters["rtt_p99_us"] = percentile(rtt_us, 0.99);
+}
+BENCHMARK(BM_DdsPoseRoundTripWaitset)->MinTime(3.0)->Unit(benchmark::kMicrosecond)->UseRealTime();
+
+// ddsperf prints one line per second per peer:
+//   [pid] 3.000  host:pid size 12 mean 33.4us min 8.5us 50% 31.2us 90% 38.8us 99% 97.4us ...
+// The median of the per-second figures (first second excluded: discovery and
+// warm-up) is reported.
+void BM_DdsperfRoundTrip(benchmark::State& state) {
+  const std::string domain = std::to_string(test::unique_domain_id());
+  std::vector<double> p50_us, p99_us;
+  for (auto _ : state) {
+    test::ChildProcess pong({"/usr/bin/ddsperf", "-D", "8", "-i", domain, "pong"});
+    // Same payload size as a serialized pose (364 bytes) for a fair figure.
+    test::ChildProcess ping({"/usr/bin/ddsperf", "-D", "5", "-i", domain, "ping", "size", "364"});
+    if (!pong.started() || !ping.started()) {
+      return state.SkipWithError("cannot run /usr/bin/ddsperf (package cyclonedds-tools)");
+    }
+    ping.wait_exit(30'000);
+    pong.terminate(5'000);
+    const std::regex line(
+        R"(^\[\d+\]\s+([\d.]+)\s+\S+ size \d+ .* 50% ([\d.]+)us .* 99% ([\d.]+)us)");
+    std::istringstream in(ping.output());
+    for (std::string l; std::getline(in, l);) {
+      std::smatch m;
+      if (std::regex_search(l, m, line) && std::stod(m[1]) > 1.5) {
+        p50_us.push_back(std::stod(m[2]));
+        p99_us.push_back(std::stod(m[3]));
+      }
+    }
+  }
+  if (p50_us.empty()) return state.SkipWithError("no latency lines in ddsperf's output");
+  const double ddsperf_p50 = percentile(p50_us, 0.5);
+  const double ddsperf_p99 = percentile(p99_us, 0.5);
+  state.counters["rtt_p50_us"] = ddsperf_p50;
+  state.counters["rtt_p99_us"] = ddsperf_p99;
+  if (g_ours_p50_us > 0.0) {
+    state.counters["ours_over_ddsperf_p50"] = g_ours_p50_us / ddsperf_p50;
+    state.counters["ours_over_ddsperf_p99"] = g_ours_p99_us / ddsperf_p99;
+    std::printf("DDS round trip, median of 1 s windows, 364-byte samples\n");
+    std::printf("DDS round trip p50: ours %.1f us, ddsperf %.1f us, ratio %.2f (target <= 1.5)\n",
+                g_ours_p50_us, ddsperf_p50, g_ours_p50_us / ddsperf_p50);
+    std::printf("DDS round trip p99: ours %.1f us, ddsperf %.1f us, ratio %.2f\n", g_ours_p99_us,
+                ddsperf_p99, g_ours_p99_us / ddsperf_p99);
+  }
+}
+BENCHMARK(BM_DdsperfRoundTrip)->Iterations(1)->Unit(benchmark::kMillisecond)->UseRealTime();
+
+}  // namespace
+}  // namespace ceilpose
+
+int main(int argc, char** argv) {
+  // Loopback only, on a domain of this run, for us and for ddsperf alike.
+  ceilpose::test::use_loopback_dds();
+  if (argc > 2 && std::strcmp(argv[1], "--pong") == 0) {
+    return ceilpose::run_pong(static_cast<uint32_t>(std::strtoul(argv[2], nullptr, 10)));
+  }
+  benchmark::Initialize(&argc, argv);
+  benchmark::RunSpecifiedBenchmarks();
+  benchmark::Shutdown();
+  return 0;
+}
