@@ -1,0 +1,93 @@
+// Each kind of bad configuration: its precise message, a non-zero exit, and
+// nothing started (no shared-memory segment).
+#include <gtest/gtest.h>
+
+#include "daemon/exit_codes.h"
+#include "tests/daemon/daemon_process.h"
+
+namespace ceilpose::test {
+namespace {
+
+struct BadConfig {
+  const char* name;
+  const char* yaml;     // nullptr: the file does not exist
+  const char* message;  // expected in stderr, after the file name
+};
+
+class DaemonBadConfig : public ::testing::TestWithParam<BadConfig> {
+ protected:
+  std::string path() {
+    const BadConfig& c = GetParam();
+    if (c.yaml == nullptr) return ::testing::TempDir() + "does-not-exist.yaml";
+    return write_temp_file("bad.yaml", c.yaml);
+  }
+};
+
+TEST_P(DaemonBadConfig, CheckConfigNamesTheProblemAndExitsThree) {
+  const std::string file = path();
+  auto r = run_daemon({"--check-config", file});
+  EXPECT_EQ(r.exit.code, daemon::kExitBadConfig);
+  EXPECT_NE(r.err.find(file + ":"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find(GetParam().message), std::string::npos) << r.err;
+}
+
+TEST_P(DaemonBadConfig, StartingRefusesBeforeCreatingAnything) {
+  const std::string file = path();
+  const std::string shm = unique_shm_name();
+  auto r = run_daemon({"--config", file, "--shm", shm, "--no-dds"});
+  EXPECT_EQ(r.exit.code, daemon::kExitBadConfig);
+  EXPECT_NE(r.err.find(GetParam().message), std::string::npos) << r.err;
+  EXPECT_FALSE(shm_exists(shm)) << "segment created despite a bad configuration";
+}
+
+INSTANTIATE_TEST_SUITE_P(
+    Kinds, DaemonBadConfig,
+    ::testing::Values(BadConfig{"SyntaxError", "camera:\n  fx: [530\n", "YAML syntax error"},
+                      BadConfig{"UnknownKey", "camera:\n  fx: 530\n  fz: 1\n",
+                                ":3: unknown key 'camera.fz'"},
+                      BadConfig{"WrongType", "capture:\n  fps: fast\n",
+                                ":2: capture.fps: expected a number, found 'fast'"},
+                      BadConfig{"OutOfRange", "dds:\n  domain_id: 999\n",
+                                ":2: dds.domain_id: expected a value in [0, 230], found '999'"},
+                      BadConfig{"MissingFile", nullptr, "cannot open configuration file"}),
+    [](const auto& info) { return std::string(info.param.name); });
+
+TEST(DaemonCommandLine, ValidFileChecksOk) {
+  auto r =
+      run_daemon({"--check-config", std::string(CEILPOSE_SOURCE_DIR) + "/config/ceilpose.yaml"});
+  EXPECT_EQ(r.exit.code, daemon::kExitOk) << r.err;
+  EXPECT_NE(r.out.find("valid"), std::string::npos);
+}
+
+TEST(DaemonCommandLine, UnknownOptionExitsTwo) {
+  auto r = run_daemon({"--frobnicate"});
+  EXPECT_EQ(r.exit.code, daemon::kExitUsage);
+}
+
+TEST(DaemonCommandLine, BadOverrideNamesTheOptionAndExitsThree) {
+  const std::string shm = unique_shm_name();
+  auto r = run_daemon({"--shm", shm, "--domain", "999"});
+  EXPECT_EQ(r.exit.code, daemon::kExitBadConfig);
+  EXPECT_NE(r.err.find("--domain: dds.domain_id"), std::string::npos) << r.err;
+  EXPECT_FALSE(shm_exists(shm));
+}
+
+TEST(DaemonCommandLine, OptionsOverrideTheFile) {
+  const std::string file = write_temp_file("c.yaml", "ipc:\n  shm_name: /from-file\n");
+  auto r =
+      run_daemon({"--config", file, "--shm", "/from-option", "--robot", "r2", "--print-config"});
+  ASSERT_EQ(r.exit.code, daemon::kExitOk) << r.err;
+  EXPECT_NE(r.out.find("shm_name: \"/from-option\""), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("robot_name: \"r2\""), std::string::npos) << r.out;
+}
+
+TEST(DaemonCommandLine, HelpListsTheSpecOptionsAndExitCodes) {
+  auto r = run_daemon({"--help"});
+  EXPECT_EQ(r.exit.code, daemon::kExitOk);
+  for (const char* opt : {"--config", "--source", "--robot", "--shm", "--domain", "--duration",
+                          "--check-config", "Exit codes"})
+    EXPECT_NE(r.out.find(opt), std::string::npos) << opt;
+}
+
+}  // namespace
+}  // namespace ceilpose::test

@@ -1,0 +1,215 @@
+// ceilposed as systemd runs it: a child process with a NOTIFY_SOCKET the test
+// owns and WATCHDOG_USEC set, on the synthetic source, a unique shared-memory
+// name and DDS off.
+#include <gtest/gtest.h>
+#include <signal.h>
+
+#include <chrono>
+#include <fstream>
+#include <sstream>
+#include <thread>
+
+#include "daemon/exit_codes.h"
+#include "ipc/shm/shm_pose_reader.h"
+#include "ipc/shm/shm_pose_writer.h"
+#include "tests/daemon/daemon_process.h"
+
+namespace ceilpose::test {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+using std::chrono::milliseconds;
+
+constexpr int kStartTimeoutMs = 20000;  // generous: ASan on a loaded 2-core machine
+constexpr int kWatchdogUsec = 400'000;  // pings expected every 200 ms
+
+// Base configuration of these tests: frequent status, a short stall allowance.
+std::string config_text(int min_rect_area_px = 150) {
+  return "detector:\n  min_rect_area_px: " + std::to_string(min_rect_area_px) +
+         "\nfilter:\n  enabled: false\nwatchdog:\n  max_stall_ms: 300\n  status_interval_ms: 200\n"
+         "dds:\n  enabled: false\n";
+}
+
+class DaemonLifecycle : public ::testing::Test {
+ protected:
+  void TearDown() override { (void)ShmPoseWriter::remove(shm_); }
+
+  std::unique_ptr<DaemonProcess> start(const std::vector<std::string>& extra = {},
+                                       std::map<std::string, std::string> env = {}) {
+    std::vector<std::string> args{"--config", config_, "--source", "synthetic", "--shm", shm_};
+    args.insert(args.end(), extra.begin(), extra.end());
+    env["NOTIFY_SOCKET"] = notify_.path();
+    env["WATCHDOG_USEC"] = std::to_string(kWatchdogUsec);
+    return std::make_unique<DaemonProcess>(args, env);
+  }
+
+  // Waits for a pose newer than after_seq; returns it (seq 0 on timeout).
+  PoseRecord next_pose(ShmPoseReader& reader, uint64_t after_seq) {
+    PoseRecord pose{};
+    if (reader.wait_next(after_seq, 5000, &pose) != WaitResult::kPose) pose.seq = 0;
+    return pose;
+  }
+
+  std::string shm_ = unique_shm_name();
+  std::string config_ = write_temp_file("ceilpose.yaml", config_text());
+  NotifySocket notify_;
+};
+
+TEST_F(DaemonLifecycle, SendsReadyThenWatchdogPingsAtHalfTheInterval) {
+  auto daemon = start();
+  ASSERT_TRUE(notify_.wait_for("READY=1", kStartTimeoutMs)) << daemon->err();
+  // Count pings over 2 s: one per 200 ms is 10; allow for a loaded machine.
+  int pings = 0;
+  const auto end = Clock::now() + milliseconds(2000);
+  while (Clock::now() < end) {
+    auto msg = notify_.receive(50);
+    if (msg && msg->find("WATCHDOG=1") != std::string::npos) ++pings;
+  }
+  EXPECT_GE(pings, 5) << daemon->err();
+  EXPECT_LE(pings, 12) << "pinging faster than half of WATCHDOG_USEC";
+  daemon->signal(SIGTERM);
+  ASSERT_TRUE(daemon->wait(5000).has_value());
+}
+
+TEST_F(DaemonLifecycle, WatchdogPingsStopWhenThePipelineStalls) {
+  auto daemon = start({}, {{"CEILPOSE_TEST_STALL_AFTER_FRAMES", "10"}});
+  ASSERT_TRUE(notify_.wait_for("READY=1", kStartTimeoutMs)) << daemon->err();
+  ASSERT_TRUE(notify_.wait_for("WATCHDOG=1", kStartTimeoutMs)) << daemon->err();
+  // A healthy daemon pings every 200 ms; a 2 s silence while it still runs
+  // means the gate closed. Bounded by 20 s in all.
+  bool silent = false;
+  auto last_ping = Clock::now();
+  const auto give_up = Clock::now() + milliseconds(20000);
+  while (!silent && Clock::now() < give_up) {
+    auto msg = notify_.receive(100);
+    if (msg && msg->find("WATCHDOG=1") != std::string::npos) last_ping = Clock::now();
+    silent = Clock::now() - last_ping > milliseconds(2000);
+  }
+  EXPECT_TRUE(silent) << "watchdog still fed by a stalled pipeline";
+  EXPECT_TRUE(daemon->running()) << "the daemon must stay up for systemd's watchdog to act";
+  EXPECT_NE(daemon->err().find("no longer feeding the watchdog"), std::string::npos)
+      << daemon->err();
+  daemon->signal(SIGTERM);
+  ASSERT_TRUE(daemon->wait(5000).has_value());
+}
+
+TEST_F(DaemonLifecycle, SigtermStopsWithinASecondWithExitZeroAndSegmentMarkedStopped) {
+  auto daemon = start();
+  ASSERT_TRUE(notify_.wait_for("READY=1", kStartTimeoutMs)) << daemon->err();
+  auto reader = ShmPoseReader::open_waiting(shm_, 5000);
+  ASSERT_TRUE(reader) << reader.error().message;
+  ASSERT_NE(next_pose(*reader, 0).seq, 0u) << daemon->err();
+
+  const auto sent = Clock::now();
+  daemon->signal(SIGTERM);
+  auto exit = daemon->wait(5000);
+  const auto took = Clock::now() - sent;
+  ASSERT_TRUE(exit.has_value()) << "still running 5 s after SIGTERM";
+  EXPECT_LE(took, milliseconds(1000));
+  EXPECT_TRUE(exit->exited);
+  EXPECT_EQ(exit->code, daemon::kExitOk) << daemon->err();
+  EXPECT_EQ(reader->writer_info().state, WriterState::kStopped);
+  EXPECT_EQ(reader->liveness(1000), Liveness::kStopped);
+  EXPECT_TRUE(notify_.wait_for("STOPPING=1", 1000));
+}
+
+TEST_F(DaemonLifecycle, SigintStopsCleanlyToo) {
+  auto daemon = start();
+  ASSERT_TRUE(notify_.wait_for("READY=1", kStartTimeoutMs)) << daemon->err();
+  daemon->signal(SIGINT);
+  auto exit = daemon->wait(5000);
+  ASSERT_TRUE(exit.has_value());
+  EXPECT_TRUE(exit->exited);
+  EXPECT_EQ(exit->code, daemon::kExitOk);
+}
+
+TEST_F(DaemonLifecycle, SighupAppliesANewThresholdWithoutDroppingTheStream) {
+  auto daemon = start();
+  ASSERT_TRUE(notify_.wait_for("READY=1", kStartTimeoutMs)) << daemon->err();
+  auto reader = ShmPoseReader::open_waiting(shm_, 5000);
+  ASSERT_TRUE(reader) << reader.error().message;
+  const uint64_t generation = reader->writer_info().generation;
+
+  // Before: the default threshold decodes markers.
+  PoseRecord before{};
+  for (int i = 0; i < 100 && before.markers == 0; ++i) before = next_pose(*reader, before.seq);
+  ASSERT_GT(before.markers, 0) << daemon->err();
+
+  // A minimum rectangle area no marker reaches: frames keep coming, markers stop.
+  write_temp_file("unused", "");  // keep temp names distinct from the config's
+  { std::ofstream(config_) << config_text(1 << 23); }
+  daemon->signal(SIGHUP);
+  ASSERT_TRUE(notify_.wait_for("READY=1", 5000)) << "no READY=1 after RELOADING=1";
+
+  PoseRecord after = before;
+  bool cleared = false;
+  for (int i = 0; i < 200 && !cleared; ++i) {
+    const PoseRecord p = next_pose(*reader, after.seq);
+    ASSERT_NE(p.seq, 0u) << "stream stopped after SIGHUP\n" << daemon->err();
+    ASSERT_GT(p.seq, after.seq);
+    after = p;
+    cleared = p.markers == 0 && !pose_is_valid(p);
+  }
+  EXPECT_TRUE(cleared) << "threshold not applied\n" << daemon->err();
+  EXPECT_EQ(reader->writer_info().generation, generation) << "the daemon restarted its segment";
+  EXPECT_TRUE(daemon->running());
+  EXPECT_NE(daemon->err().find("SIGHUP: applied detector.min_rect_area_px"), std::string::npos)
+      << daemon->err();
+  daemon->signal(SIGTERM);
+  ASSERT_TRUE(daemon->wait(5000).has_value());
+}
+
+TEST_F(DaemonLifecycle, SighupSaysWhichKeysNeedARestart) {
+  auto daemon = start();
+  ASSERT_TRUE(notify_.wait_for("READY=1", kStartTimeoutMs)) << daemon->err();
+  { std::ofstream(config_) << config_text() << "capture:\n  fps: 15.0\n"; }
+  daemon->signal(SIGHUP);
+  ASSERT_TRUE(notify_.wait_for("READY=1", 5000));
+  daemon->signal(SIGTERM);
+  ASSERT_TRUE(daemon->wait(5000).has_value());
+  EXPECT_NE(daemon->err().find("capture.fps changed but needs a restart"), std::string::npos)
+      << daemon->err();
+}
+
+TEST_F(DaemonLifecycle, DurationEndsTheRunWithExitZero) {
+  auto r = run_daemon({"--config", config_, "--shm", shm_, "--duration", "1"});
+  EXPECT_TRUE(r.exit.exited);
+  EXPECT_EQ(r.exit.code, daemon::kExitOk) << r.err;
+}
+
+TEST_F(DaemonLifecycle, LogsWithJournalPrioritiesAndNoTimestampsWhenNotATerminal) {
+  auto r = run_daemon({"--config", config_, "--shm", shm_, "--duration", "0.5"});
+  ASSERT_EQ(r.exit.code, daemon::kExitOk) << r.err;
+  std::istringstream lines(r.err);
+  int count = 0;
+  for (std::string line; std::getline(lines, line); ++count) {
+    ASSERT_GE(line.size(), 3u);
+    EXPECT_EQ(line[0], '<') << line;
+    EXPECT_TRUE(line[1] >= '0' && line[1] <= '7') << line;
+    EXPECT_EQ(line[2], '>') << line;
+    EXPECT_EQ(line.find(':'), line.find(": ")) << "looks like a timestamp: " << line;
+  }
+  EXPECT_GT(count, 0);
+}
+
+TEST_F(DaemonLifecycle, PrintPosesShowsGroundTruthAndErrorForTheSyntheticSource) {
+  auto r = run_daemon({"--config", config_, "--shm", shm_, "--duration", "1.5", "--print-poses"});
+  ASSERT_EQ(r.exit.code, daemon::kExitOk) << r.err;
+  std::istringstream lines(r.out);
+  int with_truth = 0, total = 0;
+  for (std::string line; std::getline(lines, line); ++total)
+    with_truth +=
+        line.find("truth x=") != std::string::npos && line.find(" err ") != std::string::npos;
+  EXPECT_GT(with_truth, 0) << r.out;
+  EXPECT_LE(total, 16) << "more than 10 lines a second";
+}
+
+TEST_F(DaemonLifecycle, MissingReplayExitsFourWithoutCreatingTheSegment) {
+  auto r = run_daemon({"--config", config_, "--shm", shm_, "--source", "replay:/nonexistent/rec"});
+  EXPECT_EQ(r.exit.code, daemon::kExitSourceFailure) << r.err;
+  EXPECT_NE(r.err.find("/nonexistent/rec"), std::string::npos) << r.err;
+  EXPECT_FALSE(shm_exists(shm_));
+}
+
+}  // namespace
+}  // namespace ceilpose::test
