@@ -1,6 +1,8 @@
 // ceilposectl inspect: validates a recording (SPEC §4) and summarises it.
 #include <unistd.h>
 
+#include <array>
+#include <charconv>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -125,29 +127,51 @@ Summary summarise(const RecordingReader& reader) {
   return s;
 }
 
+// Shortest text that reads back as the same double (camera values are
+// printed as recording.yaml holds them).
+std::string shortest(double v) {
+  std::array<char, 32> buf{};
+  const auto end = std::to_chars(buf.data(), buf.data() + buf.size(), v).ptr;
+  return std::string(buf.data(), end);
+}
+
+std::string fixed(double v, int decimals) {
+  char buf[64];
+  std::snprintf(buf, sizeof buf, "%.*f", decimals, v);
+  return buf;
+}
+
 void print_json(const RecordingReader& reader, const Summary& s) {
   const CameraIntrinsics& k = reader.camera().intrinsics;
-  char numbers[512];
-  std::snprintf(numbers, sizeof numbers,
-                "\"frames\":%zu,\"duration_s\":%.6f,\"fps\":%s,\"width\":%d,\"height\":%d,"
-                "\"fx\":%.17g,\"fy\":%.17g,\"cx\":%.17g,\"cy\":%.17g,"
-                "\"distortion\":[%.17g,%.17g,%.17g,%.17g,%.17g],"
-                "\"has_ground_truth\":%s,\"ground_truth_frames\":%zu,"
-                "\"png_frames\":%zu,\"jpeg_frames\":%zu",
-                s.frames, s.duration_s, s.fps > 0.0 ? std::to_string(s.fps).c_str() : "null",
-                k.width, k.height, k.fx, k.fy, k.cx, k.cy, k.distortion[0], k.distortion[1],
-                k.distortion[2], k.distortion[3], k.distortion[4],
-                s.ground_truth_frames > 0 ? "true" : "false", s.ground_truth_frames, s.png_frames,
-                s.jpeg_frames);
-  std::string out = "{\"dir\":\"" + escape_json(reader.dir()) + "\",\"valid\":true," + numbers +
-                    ",\"source\":\"" + escape_json(reader.camera().source) + "\"";
-  out += ",\"decoded\":";
-  out += s.decoded ? "true" : "false";
-  if (s.decoded) {
-    char ms[64];
-    std::snprintf(ms, sizeof ms, ",\"decode_ms_per_frame\":%.3f", s.decode_ms_per_frame);
-    out += ms;
+  std::string out = "{\"dir\":\"" + escape_json(reader.dir()) + "\",\"valid\":true";
+  auto field = [&out](const char* name, const std::string& value) {
+    out += ",\"";
+    out += name;
+    out += "\":";
+    out += value;
+  };
+  field("frames", std::to_string(s.frames));
+  field("duration_s", fixed(s.duration_s, 6));
+  field("fps", s.fps > 0.0 ? fixed(s.fps, 3) : "null");
+  field("width", std::to_string(k.width));
+  field("height", std::to_string(k.height));
+  field("fx", shortest(k.fx));
+  field("fy", shortest(k.fy));
+  field("cx", shortest(k.cx));
+  field("cy", shortest(k.cy));
+  std::string distortion = "[";
+  for (size_t c = 0; c < k.distortion.size(); ++c) {
+    if (c > 0) distortion += ',';
+    distortion += shortest(k.distortion[c]);
   }
+  field("distortion", distortion + "]");
+  field("has_ground_truth", s.ground_truth_frames > 0 ? "true" : "false");
+  field("ground_truth_frames", std::to_string(s.ground_truth_frames));
+  field("png_frames", std::to_string(s.png_frames));
+  field("jpeg_frames", std::to_string(s.jpeg_frames));
+  field("source", "\"" + escape_json(reader.camera().source) + "\"");
+  field("decoded", s.decoded ? "true" : "false");
+  if (s.decoded) field("decode_ms_per_frame", fixed(s.decode_ms_per_frame, 3));
   out += "}";
   std::cout << out << std::endl;
 }
