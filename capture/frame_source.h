@@ -112,6 +112,10 @@ class FrameSource {
   // Buffers (slots) the source cycles through; valid once streaming. At most
   // this many frames can be held outside the source at once.
   virtual int buffers() const = 0;
+  // The camera model when the source knows it (the simulator's camera, a
+  // recording's recording.yaml); false for cameras (calibration is the
+  // configuration's job). Valid once open.
+  virtual bool camera_intrinsics(CameraIntrinsics* /*out*/) const { return false; }
 
  protected:
   FrameSource() = default;

@@ -27,6 +27,11 @@ class ReplaySource final : public FrameSource {
   SourceStats stats() const override { return stats_; }
   bool live() const override { return !options_.replay_as_fast_as_possible; }
   int buffers() const override { return pool_.size(); }
+  bool camera_intrinsics(CameraIntrinsics* out) const override {
+    if (!reader_) return false;
+    *out = reader_->camera().intrinsics;
+    return true;
+  }
 
   // Valid once open.
   size_t frame_count() const { return reader_ ? reader_->rows().size() : 0; }

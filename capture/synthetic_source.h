@@ -29,6 +29,10 @@ class SyntheticSource final : public FrameSource {
   std::string describe() const override;
   SourceStats stats() const override { return stats_; }
   int buffers() const override { return pool_.size(); }
+  bool camera_intrinsics(CameraIntrinsics* out) const override {
+    *out = options_.intrinsics;
+    return true;
+  }
 
  protected:
   Result<void> do_open() override;
