@@ -145,11 +145,15 @@ void ShmFixture::start(int heartbeat_period_ms) {
   reader_.emplace(std::move(reader.value()));
 }
 
-int run_program(const std::string& path, const std::vector<std::string>& args, int timeout_ms,
-                std::string* stdout_text, std::string* stderr_text) {
+SpawnedProgram::SpawnedProgram(const std::string& path, const std::vector<std::string>& args) {
   int out[2];
   int err[2];
-  if (::pipe2(out, O_CLOEXEC) != 0 || ::pipe2(err, O_CLOEXEC) != 0) return -1;
+  if (::pipe2(out, O_CLOEXEC) != 0) return;
+  if (::pipe2(err, O_CLOEXEC) != 0) {
+    ::close(out[0]);
+    ::close(out[1]);
+    return;
+  }
   posix_spawn_file_actions_t actions;
   posix_spawn_file_actions_init(&actions);
   posix_spawn_file_actions_adddup2(&actions, out[1], 1);
@@ -163,46 +167,87 @@ int run_program(const std::string& path, const std::vector<std::string>& args, i
   posix_spawn_file_actions_destroy(&actions);
   ::close(out[1]);
   ::close(err[1]);
-  if (rc != 0) {
-    ::close(out[0]);
-    ::close(err[0]);
-    return -1;
+  out_fd_ = out[0];
+  err_fd_ = err[0];
+  if (rc == 0) pid_ = pid;
+}
+
+SpawnedProgram::~SpawnedProgram() {
+  if (pid_ > 0) {
+    ::kill(pid_, SIGKILL);
+    ::waitpid(pid_, nullptr, 0);
   }
-  std::string o;
-  std::string e;
+  for (int fd : {out_fd_, err_fd_}) {
+    if (fd >= 0) ::close(fd);
+  }
+}
+
+bool SpawnedProgram::pump(int timeout_ms) {
+  pollfd pfds[2] = {{out_fd_, POLLIN, 0}, {err_fd_, POLLIN, 0}};
+  if (out_fd_ < 0 && err_fd_ < 0) return false;
+  if (::poll(pfds, 2, timeout_ms) <= 0) return true;
+  char buf[4096];
+  for (int i = 0; i < 2; ++i) {
+    if ((pfds[i].revents & (POLLIN | POLLHUP | POLLERR)) == 0) continue;
+    int& fd = i == 0 ? out_fd_ : err_fd_;
+    const ssize_t n = ::read(fd, buf, sizeof buf);
+    if (n > 0) {
+      (i == 0 ? out_ : err_).append(buf, static_cast<size_t>(n));
+    } else {
+      ::close(fd);
+      fd = -1;
+    }
+  }
+  return true;
+}
+
+bool SpawnedProgram::wait_for_stdout(const std::string& text, int timeout_ms) {
   const int64_t deadline = monotonic_ns() + int64_t{timeout_ms} * 1'000'000;
-  bool out_open = true;
-  bool err_open = true;
+  while (out_.find(text) == std::string::npos) {
+    const int64_t left_ms = (deadline - monotonic_ns()) / 1'000'000;
+    if (left_ms <= 0 || !pump(static_cast<int>(left_ms))) return false;
+  }
+  return true;
+}
+
+bool SpawnedProgram::wait_for_stderr(const std::string& text, int timeout_ms) {
+  const int64_t deadline = monotonic_ns() + int64_t{timeout_ms} * 1'000'000;
+  while (err_.find(text) == std::string::npos) {
+    const int64_t left_ms = (deadline - monotonic_ns()) / 1'000'000;
+    if (left_ms <= 0 || !pump(static_cast<int>(left_ms))) return false;
+  }
+  return true;
+}
+
+int SpawnedProgram::finish(int timeout_ms) {
+  if (pid_ <= 0) return -1;
+  const int64_t deadline = monotonic_ns() + int64_t{timeout_ms} * 1'000'000;
   bool timed_out = false;
-  while (out_open || err_open) {
+  for (;;) {
     const int64_t left_ms = (deadline - monotonic_ns()) / 1'000'000;
     if (left_ms <= 0) {
       timed_out = true;
       break;
     }
-    pollfd pfds[2] = {{out_open ? out[0] : -1, POLLIN, 0}, {err_open ? err[0] : -1, POLLIN, 0}};
-    if (::poll(pfds, 2, static_cast<int>(left_ms)) <= 0) continue;
-    char buf[4096];
-    for (int i = 0; i < 2; ++i) {
-      if ((pfds[i].revents & (POLLIN | POLLHUP)) == 0) continue;
-      const ssize_t n = ::read(pfds[i].fd, buf, sizeof buf);
-      if (n > 0) {
-        (i == 0 ? o : e).append(buf, static_cast<size_t>(n));
-      } else {
-        (i == 0 ? out_open : err_open) = false;
-      }
-    }
+    if (!pump(static_cast<int>(left_ms))) break;
   }
-  ::close(out[0]);
-  ::close(err[0]);
-  if (timed_out) ::kill(pid, SIGKILL);
+  if (timed_out) ::kill(pid_, SIGKILL);
   int status = 0;
-  ::waitpid(pid, &status, 0);
-  if (stdout_text != nullptr) *stdout_text = o;
-  if (stderr_text != nullptr) *stderr_text = e;
+  ::waitpid(pid_, &status, 0);
+  pid_ = -1;
   if (timed_out) return -1;
   if (WIFEXITED(status)) return WEXITSTATUS(status);
   return 128 + WTERMSIG(status);
+}
+
+int run_program(const std::string& path, const std::vector<std::string>& args, int timeout_ms,
+                std::string* stdout_text, std::string* stderr_text) {
+  SpawnedProgram program(path, args);
+  if (!program.started()) return -1;
+  const int rc = program.finish(timeout_ms);
+  if (stdout_text != nullptr) *stdout_text = program.out();
+  if (stderr_text != nullptr) *stderr_text = program.err();
+  return rc;
 }
 
 }  // namespace ceilpose::test

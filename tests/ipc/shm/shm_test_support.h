@@ -99,8 +99,37 @@ class ShmFixture : public ::testing::Test {
   std::optional<ShmPoseReader> reader_;
 };
 
-// Runs `path args...` as a child with stdout captured; returns exit status
-// (-1 on timeout, the child is then killed).
+// A program run as a child process with stdout and stderr captured, so a
+// test can react to what it prints before it ends.
+class SpawnedProgram {
+ public:
+  SpawnedProgram(const std::string& path, const std::vector<std::string>& args);
+  ~SpawnedProgram();  // kills and reaps it if still running
+  SpawnedProgram(const SpawnedProgram&) = delete;
+  SpawnedProgram& operator=(const SpawnedProgram&) = delete;
+
+  bool started() const { return pid_ > 0; }
+  // Reads output until `text` appears on stdout (or stderr) or timeout_ms passes.
+  bool wait_for_stdout(const std::string& text, int timeout_ms);
+  bool wait_for_stderr(const std::string& text, int timeout_ms);
+  // Reads to the end; returns the exit status (128+signal if killed), -1 on
+  // timeout (the child is then killed).
+  int finish(int timeout_ms);
+  const std::string& out() const { return out_; }
+  const std::string& err() const { return err_; }
+
+ private:
+  // Reads whatever is available within timeout_ms; false once both pipes closed.
+  bool pump(int timeout_ms);
+  pid_t pid_ = -1;
+  int out_fd_ = -1;
+  int err_fd_ = -1;
+  std::string out_;
+  std::string err_;
+};
+
+// Runs `path args...` to the end with output captured; returns the exit
+// status (-1 on timeout, the child is then killed).
 int run_program(const std::string& path, const std::vector<std::string>& args, int timeout_ms,
                 std::string* stdout_text, std::string* stderr_text = nullptr);
 

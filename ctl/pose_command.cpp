@@ -1,0 +1,105 @@
+// ceilposectl pose: the latest pose from the daemon's shared-memory segment.
+// Exit 0 with a live pose; 3 (kExitNoDaemon) when no daemon publishes on the
+// segment or its pose is stale, saying which on stderr.
+#include <cstdio>
+#include <memory>
+#include <string>
+
+#include "core/clock.h"
+#include "ctl/command_registry.h"
+#include "ipc/shm/pose_text.h"
+#include "ipc/shm/shm_pose_reader.h"
+
+namespace ceilpose::ctl {
+namespace {
+
+struct PoseArgs {
+  std::string shm = CEILPOSE_DEFAULT_SHM_NAME;
+  bool json = false;
+  int64_t stale_ms = kDefaultStaleAfterMs;
+};
+
+int report_no_pose(const PoseArgs& args, const std::string& daemon, const std::string& why) {
+  if (args.json) {
+    std::printf("%s\n", no_pose_json(",\"daemon\":" + json_quote(daemon)).c_str());
+  }
+  std::fprintf(stderr, "ceilposectl pose: %s\n", why.c_str());
+  return kExitNoDaemon;
+}
+
+int run_pose(const PoseArgs& args) {
+  shm::ShmErrc code = shm::ShmErrc::kOk;
+  auto reader = ShmPoseReader::open(args.shm, &code);
+  if (!reader) {
+    if (code == shm::ShmErrc::kNotFound || code == shm::ShmErrc::kNotReady) {
+      return report_no_pose(args, "none", "no daemon publishing: " + reader.error().message);
+    }
+    std::fprintf(stderr, "ceilposectl pose: %s\n", reader.error().message.c_str());
+    return kExitFailure;
+  }
+  const Liveness liveness = reader->liveness(args.stale_ms);
+  const WriterInfo info = reader->writer_info();
+  PoseRecord pose{};
+  const ReadResult read = reader->read_latest(&pose);
+  const int64_t now_ns = monotonic_ns();
+  if (read == ReadResult::kNoPose) {
+    return report_no_pose(args, to_string(liveness),
+                          "ceilposed (pid " + std::to_string(info.pid) + ") on " + args.shm +
+                              " is " + to_string(liveness) + " and has published no pose yet");
+  }
+  if (read == ReadResult::kBusy) {
+    std::fprintf(stderr, "ceilposectl pose: %s on %s\n", to_string(read), args.shm.c_str());
+    return kExitFailure;
+  }
+  const double age_ms = static_cast<double>(now_ns - pose.publish_mono_ns) / 1e6;
+  std::string problem;
+  if (liveness != Liveness::kLive) {
+    problem = "daemon (pid " + std::to_string(info.pid) + ") on " + args.shm + " is " +
+              to_string(liveness) + "; last pose is " + fixed_text(age_ms, 1) + " ms old";
+  } else if (age_ms > static_cast<double>(args.stale_ms)) {
+    problem = "pose is stale: " + fixed_text(age_ms, 1) + " ms old (limit " +
+              std::to_string(args.stale_ms) + " ms), daemon pid " + std::to_string(info.pid) +
+              " is alive but not publishing";
+  }
+  const std::string daemon = problem.empty() || liveness != Liveness::kLive
+                                 ? to_string(liveness)
+                                 : std::string("stale-pose");
+  if (args.json) {
+    std::printf("%s\n", pose_json(pose, now_ns,
+                                  ",\"daemon\":" + json_quote(daemon) +
+                                      ",\"live\":" + (problem.empty() ? "true" : "false"))
+                            .c_str());
+  } else {
+    std::printf("%s\n", pose_line(pose, now_ns).c_str());
+  }
+  if (!problem.empty()) {
+    std::fprintf(stderr, "ceilposectl pose: %s\n", problem.c_str());
+    return kExitNoDaemon;
+  }
+  return kExitOk;
+}
+
+void add_pose_command(CLI::App& app) {
+  auto args = std::make_shared<PoseArgs>();
+  CLI::App* cmd = app.add_subcommand(
+      "pose",
+      "Print the latest pose from the daemon's shared memory. Exit 0 with a live pose; 3 when "
+      "no daemon is publishing, it stopped or died, or its pose is stale (stderr says which). "
+      "--json prints seq, valid, x_m, y_m, yaw_rad (null when invalid), mode, markers, "
+      "timestamp_ns (capture, CLOCK_MONOTONIC) and more, plus daemon and live.");
+  cmd->add_option("--shm", args->shm, "shared-memory segment name")->capture_default_str();
+  cmd->add_flag("--json", args->json, "one JSON object for scripts");
+  cmd->add_option("--stale-ms", args->stale_ms, "a pose or heartbeat older than this is stale")
+      ->capture_default_str()
+      ->check(CLI::PositiveNumber);
+  cmd->callback([args] {
+    const int rc = run_pose(*args);
+    std::fflush(stdout);
+    set_exit_code(rc);
+  });
+}
+
+const CommandRegistrar kReg{"pose", &add_pose_command};
+
+}  // namespace
+}  // namespace ceilpose::ctl

@@ -1,0 +1,150 @@
+// ceilposectl status: the daemon's health from its shared-memory segment —
+// state, pid, uptime, frame rate, frames, drops, outages, latency percentiles,
+// fix state and source. Exit 0 when the daemon is live, 3 otherwise.
+#include <cinttypes>
+#include <cstdio>
+#include <memory>
+#include <string>
+
+#include "core/clock.h"
+#include "ctl/command_registry.h"
+#include "ipc/shm/pose_text.h"
+#include "ipc/shm/shm_pose_reader.h"
+
+namespace ceilpose::ctl {
+namespace {
+
+struct StatusArgs {
+  std::string shm = CEILPOSE_DEFAULT_SHM_NAME;
+  bool json = false;
+  int64_t stale_ms = kDefaultStaleAfterMs;
+};
+
+struct Snapshot {
+  Liveness liveness;
+  WriterInfo info;
+  StatusRecord status{};
+  bool has_status = false;
+  PoseRecord pose{};
+  bool has_pose = false;
+  int64_t now_ns = 0;
+};
+
+std::string age_ms_json(bool known, int64_t now_ns, int64_t then_ns) {
+  return known ? fixed_text(static_cast<double>(now_ns - then_ns) / 1e6, 1) : "null";
+}
+
+void print_json(const StatusArgs& args, const Snapshot& s) {
+  const StatusRecord& st = s.status;
+  std::string out =
+      "{\"shm\":" + json_quote(args.shm) + ",\"state\":" + json_quote(to_string(s.info.state)) +
+      ",\"liveness\":" + json_quote(to_string(s.liveness)) +
+      ",\"live\":" + (s.liveness == Liveness::kLive ? "true" : "false") +
+      ",\"pid\":" + std::to_string(s.info.pid) +
+      ",\"generation\":" + std::to_string(s.info.generation) +
+      ",\"uptime_s\":" + fixed_text(static_cast<double>(s.now_ns - s.info.start_mono_ns) / 1e9, 3) +
+      ",\"start_real_ns\":" + std::to_string(s.info.start_real_ns) +
+      ",\"heartbeat_age_ms\":" + age_ms_json(true, s.now_ns, s.info.heartbeat_mono_ns);
+  if (s.has_status) {
+    out += ",\"fps\":" + fixed_text(st.fps, 2) + ",\"frames\":" + std::to_string(st.frames) +
+           ",\"drops\":" + std::to_string(st.drops) + ",\"skipped\":" + std::to_string(st.skipped) +
+           ",\"outages\":" + std::to_string(st.outages) +
+           ",\"latency_us\":{\"p50\":" + std::to_string(st.latency_p50_us) +
+           ",\"p90\":" + std::to_string(st.latency_p90_us) +
+           ",\"p99\":" + std::to_string(st.latency_p99_us) +
+           ",\"max\":" + std::to_string(st.latency_max_us) + "}" +
+           ",\"fix\":" + json_quote(to_string(static_cast<FixState>(st.fix_state))) +
+           ",\"source\":" + json_quote(st.source) +
+           ",\"status_age_ms\":" + age_ms_json(true, s.now_ns, st.updated_mono_ns);
+  } else {
+    out +=
+        ",\"fps\":null,\"frames\":null,\"drops\":null,\"skipped\":null,\"outages\":null,"
+        "\"latency_us\":null,\"fix\":null,\"source\":null,\"status_age_ms\":null";
+  }
+  out += ",\"last_seq\":" + (s.has_pose ? std::to_string(s.pose.seq) : std::string("null")) +
+         ",\"last_pose_age_ms\":" + age_ms_json(s.has_pose, s.now_ns, s.pose.publish_mono_ns) + "}";
+  std::printf("%s\n", out.c_str());
+}
+
+void print_human(const StatusArgs& args, const Snapshot& s) {
+  const StatusRecord& st = s.status;
+  std::printf("ceilposed on %s: %s (%s), pid %d, up %s\n", args.shm.c_str(),
+              to_string(s.info.state), to_string(s.liveness), s.info.pid,
+              duration_text(s.now_ns - s.info.start_mono_ns).c_str());
+  if (s.has_status) {
+    std::printf("  source     %s\n", st.source[0] != '\0' ? st.source : "(not reported)");
+    std::printf("  fix        %s\n", to_string(static_cast<FixState>(st.fix_state)));
+    std::printf("  rate       %.1f fps\n", st.fps);
+    std::printf("  frames     %" PRIu64 "  drops %" PRIu64 "  skipped %" PRIu64 "  outages %" PRIu64
+                "\n",
+                st.frames, st.drops, st.skipped, st.outages);
+    std::printf(
+        "  latency    p50 %.2f ms  p90 %.2f ms  p99 %.2f ms  max %.2f ms"
+        "  (capture -> pose published)\n",
+        st.latency_p50_us / 1e3, st.latency_p90_us / 1e3, st.latency_p99_us / 1e3,
+        st.latency_max_us / 1e3);
+  } else {
+    std::printf("  (the daemon has not reported its status yet)\n");
+  }
+  if (s.has_pose) {
+    std::printf("  last pose  %s\n", pose_line(s.pose, s.now_ns).c_str());
+  } else {
+    std::printf("  last pose  none yet\n");
+  }
+  std::printf("  heartbeat  %.1f ms ago\n",
+              static_cast<double>(s.now_ns - s.info.heartbeat_mono_ns) / 1e6);
+}
+
+int run_status(const StatusArgs& args) {
+  shm::ShmErrc code = shm::ShmErrc::kOk;
+  auto reader = ShmPoseReader::open(args.shm, &code);
+  if (!reader) {
+    std::fprintf(stderr, "ceilposectl status: %s\n", reader.error().message.c_str());
+    if (args.json) {
+      std::printf("{\"shm\":%s,\"state\":null,\"liveness\":\"none\",\"live\":false,\"error\":%s}\n",
+                  json_quote(args.shm).c_str(), json_quote(reader.error().message).c_str());
+    }
+    const bool no_daemon = code == shm::ShmErrc::kNotFound || code == shm::ShmErrc::kNotReady;
+    return no_daemon ? kExitNoDaemon : kExitFailure;
+  }
+  Snapshot s;
+  s.liveness = reader->liveness(args.stale_ms);
+  s.info = reader->writer_info();
+  s.has_status = reader->read_status(&s.status) == ReadResult::kOk && s.status.updated_mono_ns != 0;
+  s.has_pose = reader->read_latest(&s.pose) == ReadResult::kOk;
+  s.now_ns = monotonic_ns();
+  if (args.json) {
+    print_json(args, s);
+  } else {
+    print_human(args, s);
+  }
+  if (s.liveness == Liveness::kLive || s.liveness == Liveness::kStarting) return kExitOk;
+  std::fprintf(stderr, "ceilposectl status: daemon on %s is %s%s\n", args.shm.c_str(),
+               to_string(s.liveness),
+               s.liveness == Liveness::kRestarted ? " (a new daemon took over; run again)" : "");
+  return kExitNoDaemon;
+}
+
+void add_status_command(CLI::App& app) {
+  auto args = std::make_shared<StatusArgs>();
+  CLI::App* cmd = app.add_subcommand(
+      "status",
+      "Show the daemon's health from its shared memory: state, pid, uptime, fps, frames, drops, "
+      "skipped, outages, latency percentiles, fix state, source. Exit 0 when the daemon is live "
+      "(or starting), 3 when none is publishing or it stopped, died or is stale.");
+  cmd->add_option("--shm", args->shm, "shared-memory segment name")->capture_default_str();
+  cmd->add_flag("--json", args->json, "one JSON object for scripts");
+  cmd->add_option("--stale-ms", args->stale_ms, "a heartbeat older than this is stale")
+      ->capture_default_str()
+      ->check(CLI::PositiveNumber);
+  cmd->callback([args] {
+    const int rc = run_status(*args);
+    std::fflush(stdout);
+    set_exit_code(rc);
+  });
+}
+
+const CommandRegistrar kReg{"status", &add_status_command};
+
+}  // namespace
+}  // namespace ceilpose::ctl

@@ -1,0 +1,129 @@
+// ceilposectl watch: streams poses as the daemon publishes them (blocking on
+// the segment's futex, no polling): a table for people, JSON lines with
+// --json. Waits for a daemon that is not running yet and follows a restart by
+// re-attaching to the new segment.
+#include <unistd.h>
+
+#include <chrono>
+#include <cstdio>
+#include <memory>
+#include <string>
+#include <thread>
+
+#include "core/clock.h"
+#include "ctl/command_registry.h"
+#include "ipc/shm/pose_text.h"
+#include "ipc/shm/shm_pose_reader.h"
+
+namespace ceilpose::ctl {
+namespace {
+
+struct WatchArgs {
+  std::string shm = CEILPOSE_DEFAULT_SHM_NAME;
+  bool json = false;
+  uint64_t count = 0;  // 0: until interrupted
+  int64_t stale_ms = kDefaultStaleAfterMs;
+};
+
+// How long one wait lasts before the reader re-checks for a restart.
+constexpr int kWaitSliceMs = 500;
+// After a stop or death, how often to look for the daemon's successor.
+constexpr auto kSuccessorCheck = std::chrono::milliseconds(100);
+constexpr int kHeaderEveryRows = 40;
+
+void note(const std::string& text) {
+  std::fprintf(stderr, "ceilposectl watch: %s\n", text.c_str());
+}
+
+Result<ShmPoseReader> attach(const WatchArgs& args, shm::ShmErrc* code) {
+  auto reader = ShmPoseReader::open(args.shm, code);
+  if (reader || (*code != shm::ShmErrc::kNotFound && *code != shm::ShmErrc::kNotReady)) {
+    return reader;
+  }
+  note(reader.error().message + "; waiting for ceilposed to start");
+  return ShmPoseReader::open_waiting(args.shm, -1, code);
+}
+
+int run_watch(const WatchArgs& args) {
+  shm::ShmErrc code = shm::ShmErrc::kOk;
+  auto opened = attach(args, &code);
+  if (!opened) {
+    note(opened.error().message);
+    return kExitFailure;
+  }
+  ShmPoseReader reader = std::move(opened.value());
+  const bool tty = ::isatty(STDOUT_FILENO) != 0;
+  uint64_t last_seq = 0;
+  uint64_t printed = 0;
+  std::string reported;  // the last liveness problem told to the user
+  while (args.count == 0 || printed < args.count) {
+    PoseRecord pose;
+    const WaitResult r = reader.wait_next(last_seq, kWaitSliceMs, &pose);
+    if (r == WaitResult::kPose) {
+      const int64_t now_ns = monotonic_ns();
+      if (args.json) {
+        std::printf("%s\n", pose_json(pose, now_ns).c_str());
+      } else {
+        if (printed == 0 || (tty && printed % kHeaderEveryRows == 0)) {
+          std::printf("%s\n", pose_table_header().c_str());
+        }
+        std::printf("%s\n", pose_table_row(pose, now_ns).c_str());
+      }
+      std::fflush(stdout);
+      last_seq = pose.seq;
+      ++printed;
+      reported.clear();
+      continue;
+    }
+    if (r == WaitResult::kBusy) continue;
+    const Liveness liveness = reader.liveness(args.stale_ms);
+    if (liveness == Liveness::kRestarted) {
+      shm::ShmErrc reattach_code = shm::ShmErrc::kOk;
+      if (reader.reattach(&reattach_code)) {
+        note("daemon restarted: re-attached to " + args.shm + " (pid " +
+             std::to_string(reader.writer_info().pid) + ")");
+        last_seq = 0;  // a new writer counts from 1 again
+        reported.clear();
+      } else {
+        std::this_thread::sleep_for(kSuccessorCheck);  // still initializing
+      }
+      continue;
+    }
+    if (liveness != Liveness::kLive && liveness != Liveness::kStarting &&
+        reported != to_string(liveness)) {
+      reported = to_string(liveness);
+      note("daemon (pid " + std::to_string(reader.writer_info().pid) + ") on " + args.shm + " is " +
+           reported + "; waiting");
+    }
+    // wait_next returns at once for a stopped or dead writer.
+    if (r != WaitResult::kTimeout) std::this_thread::sleep_for(kSuccessorCheck);
+  }
+  return kExitOk;
+}
+
+void add_watch_command(CLI::App& app) {
+  auto args = std::make_shared<WatchArgs>();
+  CLI::App* cmd = app.add_subcommand(
+      "watch",
+      "Stream poses from the daemon's shared memory as they are published: a table for people, "
+      "one JSON object per line with --json (seq, valid, x_m, y_m, yaw_rad, mode, markers, "
+      "timestamp_ns, ...). Waits for the daemon if it is not running and re-attaches when it "
+      "restarts. Exit 0 after --count poses.");
+  cmd->add_option("--shm", args->shm, "shared-memory segment name")->capture_default_str();
+  cmd->add_flag("--json", args->json, "JSON lines for machines");
+  cmd->add_option("--count", args->count, "stop after N poses (0: until interrupted)")
+      ->capture_default_str();
+  cmd->add_option("--stale-ms", args->stale_ms, "a heartbeat older than this is stale")
+      ->capture_default_str()
+      ->check(CLI::PositiveNumber);
+  cmd->callback([args] {
+    const int rc = run_watch(*args);
+    std::fflush(stdout);
+    set_exit_code(rc);
+  });
+}
+
+const CommandRegistrar kReg{"watch", &add_watch_command};
+
+}  // namespace
+}  // namespace ceilpose::ctl

@@ -1,0 +1,213 @@
+// ceilposectl status / pose / watch run as separate processes against a
+// writer in the test process (SPEC §7 names, flags, JSON fields, exit codes).
+#include <gtest/gtest.h>
+
+#include <atomic>
+#include <chrono>
+#include <thread>
+
+#include "core/clock.h"
+#include "ipc/shm/shm_pose_reader.h"
+#include "ipc/shm/shm_pose_writer.h"
+#include "shm_test_support.h"
+
+namespace ceilpose {
+namespace {
+
+constexpr int kExitNoDaemon = 3;  // ctl/command_registry.h
+constexpr int kRunTimeoutMs = 30'000;
+
+class CtlCommands : public test::ShmFixture {
+ protected:
+  int run(const std::vector<std::string>& args) {
+    return test::run_program(CEILPOSECTL_PATH, args, kRunTimeoutMs, &out_, &err_);
+  }
+  std::string out_;
+  std::string err_;
+};
+
+bool contains(const std::string& text, const std::string& part) {
+  return text.find(part) != std::string::npos;
+}
+
+PoseRecord sample_pose(int64_t capture_mono_ns) {
+  PoseRecord p{};
+  p.capture_mono_ns = capture_mono_ns;
+  p.x_m = 1.25;
+  p.y_m = -0.5;
+  p.yaw_rad = 0.3;
+  p.covariance[0] = 1e-6;
+  p.flags = kPoseValid | kPoseFiltered;
+  p.mode = CEILPOSE_MODE_LSQ;
+  p.markers = 9;
+  return p;
+}
+
+size_t count_lines(const std::string& text) {
+  return static_cast<size_t>(std::count(text.begin(), text.end(), '\n'));
+}
+
+TEST_F(CtlCommands, PoseJsonPrintsLivePoseWithSpecFieldsAndExitsZero) {
+  ASSERT_NO_FATAL_FAILURE(start());
+  writer().publish(sample_pose(123456789));
+  EXPECT_EQ(run({"pose", "--shm", name(), "--json"}), 0) << err_;
+  EXPECT_TRUE(contains(out_, "\"seq\":1,")) << out_;
+  EXPECT_TRUE(contains(out_, "\"valid\":true")) << out_;
+  EXPECT_TRUE(contains(out_, "\"x_m\":1.2500000")) << out_;
+  EXPECT_TRUE(contains(out_, "\"y_m\":-0.5000000")) << out_;
+  EXPECT_TRUE(contains(out_, "\"yaw_rad\":0.3000000")) << out_;
+  EXPECT_TRUE(contains(out_, "\"mode\":\"lsq\"")) << out_;
+  EXPECT_TRUE(contains(out_, "\"markers\":9")) << out_;
+  EXPECT_TRUE(contains(out_, "\"timestamp_ns\":123456789")) << out_;
+  EXPECT_EQ(count_lines(out_), 1u);
+}
+
+TEST_F(CtlCommands, PoseJsonHasNullPoseFieldsWhenInvalid) {
+  ASSERT_NO_FATAL_FAILURE(start());
+  PoseRecord p = sample_pose(1);
+  p.flags = 0;
+  writer().publish(p);
+  EXPECT_EQ(run({"pose", "--shm", name(), "--json"}), 0) << err_;
+  EXPECT_TRUE(contains(out_, "\"valid\":false,\"x_m\":null,\"y_m\":null,\"yaw_rad\":null")) << out_;
+}
+
+TEST_F(CtlCommands, PoseHumanOutputShowsPositionAndMode) {
+  ASSERT_NO_FATAL_FAILURE(start());
+  writer().publish(sample_pose(1));
+  EXPECT_EQ(run({"pose", "--shm", name()}), 0) << err_;
+  EXPECT_TRUE(contains(out_, "x 1.2500 m")) << out_;
+  EXPECT_TRUE(contains(out_, "mode lsq")) << out_;
+}
+
+TEST_F(CtlCommands, PoseExitsNoDaemonWhenSegmentIsMissing) {
+  EXPECT_EQ(run({"pose", "--shm", name()}), kExitNoDaemon);
+  EXPECT_TRUE(contains(err_, "no daemon")) << err_;
+  EXPECT_TRUE(contains(err_, name())) << err_;
+}
+
+TEST_F(CtlCommands, PoseExitsNoDaemonWhenPoseIsStale) {
+  ASSERT_NO_FATAL_FAILURE(start());
+  PoseRecord p = sample_pose(1);
+  p.publish_mono_ns = monotonic_ns() - 5'000'000'000;  // published 5 s ago
+  writer().publish(p);
+  EXPECT_EQ(run({"pose", "--shm", name(), "--stale-ms", "1000"}), kExitNoDaemon);
+  EXPECT_TRUE(contains(err_, "stale")) << err_;
+}
+
+TEST_F(CtlCommands, PoseExitsNoDaemonWhenDaemonStopped) {
+  ASSERT_NO_FATAL_FAILURE(start());
+  writer().publish(sample_pose(1));
+  writer().mark_stopped();
+  EXPECT_EQ(run({"pose", "--shm", name(), "--json"}), kExitNoDaemon);
+  EXPECT_TRUE(contains(err_, "stopped")) << err_;
+  EXPECT_TRUE(contains(out_, "\"live\":false")) << out_;
+}
+
+TEST_F(CtlCommands, PoseExitsNoDaemonBeforeFirstPose) {
+  ASSERT_NO_FATAL_FAILURE(start());
+  EXPECT_EQ(run({"pose", "--shm", name()}), kExitNoDaemon);
+  EXPECT_TRUE(contains(err_, "no pose yet")) << err_;
+}
+
+TEST_F(CtlCommands, StatusJsonShowsDaemonHealth) {
+  ASSERT_NO_FATAL_FAILURE(start());
+  StatusRecord s{};
+  s.fps = 29.5;
+  s.frames = 1000;
+  s.drops = 2;
+  s.skipped = 3;
+  s.outages = 1;
+  s.latency_p50_us = 4100;
+  s.latency_p90_us = 5200;
+  s.latency_p99_us = 7300;
+  s.latency_max_us = 9900;
+  s.fix_state = CEILPOSE_FIX_OK;
+  set_status_source(&s, "v4l2:/dev/video0");
+  writer().update_status(s);
+  writer().publish(sample_pose(1));
+  EXPECT_EQ(run({"status", "--shm", name(), "--json"}), 0) << err_;
+  for (const std::string field :
+       {"\"state\":\"running\"", "\"liveness\":\"live\"", "\"fps\":29.50", "\"frames\":1000",
+        "\"drops\":2", "\"skipped\":3", "\"outages\":1", "\"p50\":4100", "\"p90\":5200",
+        "\"p99\":7300", "\"max\":9900", "\"fix\":\"fix\"", "\"source\":\"v4l2:/dev/video0\"",
+        "\"last_seq\":1"}) {
+    EXPECT_TRUE(contains(out_, field)) << field << " missing in " << out_;
+  }
+  EXPECT_TRUE(contains(out_, "\"pid\":" + std::to_string(::getpid()))) << out_;
+}
+
+TEST_F(CtlCommands, StatusHumanOutputNamesSourceAndLatency) {
+  ASSERT_NO_FATAL_FAILURE(start());
+  StatusRecord s{};
+  s.latency_p99_us = 7300;
+  set_status_source(&s, "synthetic");
+  writer().update_status(s);
+  EXPECT_EQ(run({"status", "--shm", name()}), 0) << err_;
+  EXPECT_TRUE(contains(out_, "synthetic")) << out_;
+  EXPECT_TRUE(contains(out_, "p99 7.30 ms")) << out_;
+}
+
+TEST_F(CtlCommands, StatusExitsNoDaemonWhenSegmentIsMissing) {
+  EXPECT_EQ(run({"status", "--shm", name()}), kExitNoDaemon);
+  EXPECT_TRUE(contains(err_, name())) << err_;
+}
+
+TEST_F(CtlCommands, WatchJsonStreamsCountPosesAsTheyArePublished) {
+  ASSERT_NO_FATAL_FAILURE(start());
+  std::atomic<bool> finished{false};
+  std::thread publisher([&] {
+    for (int64_t k = 1; !finished.load() && k < 10'000; ++k) {
+      std::this_thread::sleep_for(std::chrono::milliseconds(20));
+      writer().publish(sample_pose(k));
+    }
+  });
+  const int rc = run({"watch", "--shm", name(), "--json", "--count", "3"});
+  finished.store(true);
+  publisher.join();
+  EXPECT_EQ(rc, 0) << err_;
+  EXPECT_EQ(count_lines(out_), 3u) << out_;
+  EXPECT_TRUE(contains(out_, "\"markers\":9")) << out_;
+}
+
+TEST_F(CtlCommands, WatchWaitsForDaemonThatStartsLater) {
+  test::SpawnedProgram watch(CEILPOSECTL_PATH,
+                             {"watch", "--shm", name(), "--json", "--count", "2"});
+  ASSERT_TRUE(watch.started());
+  ASSERT_TRUE(watch.wait_for_stderr("waiting for ceilposed", kRunTimeoutMs)) << watch.err();
+  ASSERT_NO_FATAL_FAILURE(start());
+  writer().publish(sample_pose(1));
+  ASSERT_TRUE(watch.wait_for_stdout("\"seq\":1,", kRunTimeoutMs)) << watch.err();
+  writer().publish(sample_pose(2));
+  EXPECT_EQ(watch.finish(kRunTimeoutMs), 0) << watch.err();
+  EXPECT_EQ(count_lines(watch.out()), 2u) << watch.out();
+}
+
+TEST_F(CtlCommands, WatchReattachesAcrossDaemonRestart) {
+  ASSERT_NO_FATAL_FAILURE(start());
+  writer().publish(sample_pose(1));
+  test::SpawnedProgram watch(CEILPOSECTL_PATH,
+                             {"watch", "--shm", name(), "--json", "--count", "2"});
+  ASSERT_TRUE(watch.started());
+  ASSERT_TRUE(watch.wait_for_stdout("\"seq\":1,", kRunTimeoutMs)) << watch.err();
+  writer_.reset();  // the first daemon stops cleanly
+  ShmOptions options;
+  options.name = name();
+  auto second = ShmPoseWriter::create(options);
+  ASSERT_TRUE(second) << second.error().message;
+  ASSERT_TRUE(watch.wait_for_stderr("re-attached", kRunTimeoutMs)) << watch.err();
+  second->publish(sample_pose(7));
+  EXPECT_EQ(watch.finish(kRunTimeoutMs), 0) << watch.err();
+  EXPECT_EQ(count_lines(watch.out()), 2u) << watch.out();
+  EXPECT_TRUE(contains(watch.out(), "\"timestamp_ns\":7")) << watch.out();
+}
+
+TEST_F(CtlCommands, WatchTablePrintsHeaderAndRows) {
+  ASSERT_NO_FATAL_FAILURE(start());
+  for (int64_t k = 1; k <= 2; ++k) writer().publish(sample_pose(k));
+  EXPECT_EQ(run({"watch", "--shm", name(), "--count", "1"}), 0) << err_;
+  EXPECT_TRUE(contains(out_, "yaw_deg")) << out_;
+  EXPECT_TRUE(contains(out_, "1.2500")) << out_;
+}
+
+}  // namespace
+}  // namespace ceilpose
