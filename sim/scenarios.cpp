@@ -112,7 +112,7 @@ void jpeg(Context& c, Effects& e) { e.jpeg_quality = static_cast<int>(c.rng(40.0
 
 void fixtures(Context& c, Effects& e) {
   e.gain = c.rng(1.0, 1.6);
-  e.bloom = c.rng(0.3, 1.0);
+  e.bloom = c.rng(0.1, 0.5);
 }
 
 void occlusion(Context& c, Effects& e) { e.occlusion_fraction = c.rng(0.05, 0.35); }
@@ -131,7 +131,7 @@ void stress(Context& c, Effects& e) {
   e.motion_blur_angle_rad = c.rng(-kPi, kPi);
   e.gradient_amplitude = c.rng(0.0, 0.3);
   e.gradient_angle_rad = c.rng(-kPi, kPi);
-  e.bloom = 0.5;
+  e.bloom = 0.1;
   e.clutter_objects = 6;
   e.jpeg_quality = 60;
 }
@@ -187,13 +187,13 @@ constexpr std::array<Entry, 17> kEntries{{
     {"motion_blur", "random poses, motion blur 2-10 px in a random direction", nullptr,
      &motion_blur},
     {"jpeg", "random poses, JPEG round trip at quality 40-80", nullptr, &jpeg},
-    {"fixtures", "random poses, saturated light fixtures with bloom 0.3-1, gain 1-1.6", nullptr,
+    {"fixtures", "random poses, saturated light fixtures with bloom 0.1-0.5, gain 1-1.6", nullptr,
      &fixtures},
     {"occlusion", "random poses, a dark occluder covering 5-35% of the image", nullptr, &occlusion},
     {"clutter", "random poses, 16 red/green non-marker objects on the ceiling", nullptr, &clutter},
     {"stress",
      "all effects combined at issue 3 levels: gain 0.45-1.6, +-25% colour cast, noise sigma 6, "
-     "defocus 0.5-1.2 px, motion blur <= 3 px, gradient <= 30%, bloom, 6 clutter objects, "
+     "defocus 0.5-1.2 px, motion blur <= 3 px, gradient <= 30%, bloom 0.1, 6 clutter objects, "
      "JPEG 60 (no occlusion)",
      nullptr, &stress},
     {"tilt", "random poses, camera tilted 0-3 degrees in a random direction, read noise 2", &tilt,
