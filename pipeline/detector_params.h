@@ -25,7 +25,7 @@ struct DetectorParams {
   // Red versus green is decided by r - g (normalised levels) against this
   // split: r - g is linear in the mix, so a pixel on the shared edge goes to
   // the rectangle that covers more of it. Cost: none.
-  int red_green_split = 25;
+  int red_green_split = 28;
   // Hue windows (degrees) that a saturated pixel must fall in to be red or
   // green; everything else saturated (blue, yellow clutter) is background.
   float red_hue_min_deg = -60.0f;  // i.e. 300°

@@ -58,6 +58,21 @@ double patch_brightness(const ImageView& frame, const MarkerFrame& m, double e_m
   return sum / 9.0;
 }
 
+// Mean brightness of three points across a slot: (e − spread, n), (e, n),
+// (e + spread, n). Returns −1 when a point is outside.
+double line_brightness(const ImageView& frame, const MarkerFrame& m, double e_m, double n_m,
+                       double spread_e_m) {
+  double sum = 0.0;
+  for (int ie = -1; ie <= 1; ++ie) {
+    double u = 0.0, v = 0.0;
+    m.project(e_m + ie * spread_e_m, n_m, &u, &v);
+    const double b = brightness_at(frame, u, v);
+    if (b < 0.0) return -1.0;
+    sum += b;
+  }
+  return sum / 3.0;
+}
+
 }  // namespace
 
 MarkerFrame marker_frame(const RectangleCandidate& red, const RectangleCandidate& green,
@@ -65,10 +80,17 @@ MarkerFrame marker_frame(const RectangleCandidate& red, const RectangleCandidate
   MarkerFrame m;
   m.centre_u_px = 0.5 * (red.cx + green.cx);
   m.centre_v_px = 0.5 * (red.cy + green.cy);
-  const double du = green.cx - red.cx, dv = green.cy - red.cy;
-  const double dist = std::hypot(du, dv);
-  m.west_image_rad = std::atan2(dv, du);
-  const double a = dist > 0.0 ? du / dist : 1.0, b = dist > 0.0 ? dv / dist : 0.0;
+  // West is perpendicular to the long axes, on the green side. The axes,
+  // measured along 12 in edges, fix the direction about ten times better
+  // than the 5 in red→green baseline, which only gives the sign.
+  const double c2 = red.area_px * std::cos(2.0 * red.axis_rad) +
+                    green.area_px * std::cos(2.0 * green.axis_rad);
+  const double s2 = red.area_px * std::sin(2.0 * red.axis_rad) +
+                    green.area_px * std::sin(2.0 * green.axis_rad);
+  const double axis_rad = 0.5 * std::atan2(s2, c2);
+  double a = -std::sin(axis_rad), b = std::cos(axis_rad);
+  if (a * (green.cx - red.cx) + b * (green.cy - red.cy) < 0.0) a = -a, b = -b;
+  m.west_image_rad = std::atan2(b, a);
   const double px_per_m = 0.5 * (red.long_px + green.long_px) / layout.rect_height_m;
   m.east_u = -a * px_per_m;
   m.east_v = -b * px_per_m;
@@ -101,20 +123,22 @@ CodeReading read_code(const ImageView& frame, const MarkerFrame& marker, bool re
   const double reference = ref_sum / ref_count;
   if (reference < 1.0) return out;
   const double px_per_m = std::hypot(marker.north_u, marker.north_v);
-  const double step_m = px_per_m > 0.0 ? 1.0 / px_per_m : params.dot_search_m;
+  // One pixel, or a sixth of the dot's height in large images.
+  const double step_m = std::max(px_per_m > 0.0 ? 1.0 / px_per_m : params.dot_search_m,
+                                 (red ? layout.red_dot_n_m : layout.green_dot_n_m) / 6.0);
   const int search_steps = std::clamp(static_cast<int>(params.dot_search_m / step_m), 0, 32);
   int code = 0;
   double margin = 1.0;
   for (int k = 0; k < layout.bits; ++k) {
     // The dot's darkest line: lines across the slot (three points, a
-    // quarter of the dot's width apart) one pixel apart over ±dot_search_m
+    // quarter of the dot's width apart) a pixel apart over ±dot_search_m
     // along North; the darkest is the dot's core wherever blur, a rectangle
     // eaten by glare or a slightly wrong scale put it. The search stays
     // clear of the neighbouring slots' dots (pitch 4 in).
     double b = -1.0;
     for (int step = -search_steps; step <= search_steps; ++step) {
-      const double line = patch_brightness(frame, marker, e_m, layout.slot_n_m(k) + step * step_m,
-                                           0.25 * dot_e_m, 0.0);
+      const double line =
+          line_brightness(frame, marker, e_m, layout.slot_n_m(k) + step * step_m, 0.25 * dot_e_m);
       if (line < 0.0) return out;
       b = b < 0.0 ? line : std::min(b, line);
     }

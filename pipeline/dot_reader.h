@@ -17,7 +17,7 @@ struct MarkerFrame {
   double centre_u_px = 0.0, centre_v_px = 0.0;
   double east_u = 0.0, east_v = 0.0;    // pixels per metre East
   double north_u = 0.0, north_v = 0.0;  // pixels per metre North
-  double west_image_rad = 0.0;          // atan2 of the red→green vector
+  double west_image_rad = 0.0;          // image angle of West (red→green)
 
   void project(double e_m, double n_m, double* u_px, double* v_px) const {
     *u_px = centre_u_px + e_m * east_u + n_m * north_u;

@@ -1,0 +1,98 @@
+#include "pipeline/color_classifier.h"
+
+#include <gtest/gtest.h>
+
+#include <vector>
+
+#include "tests/pipeline/detect_scene_support.h"
+
+namespace ceilpose {
+namespace {
+
+class ColorClassifierTest : public ::testing::Test {
+ protected:
+  CeilingLayout layout;
+  DetectorParams params;
+  ColorClassifier classifier{params, layout.tile};
+};
+
+TEST_F(ColorClassifierTest, PrintedColoursGetTheirClass) {
+  EXPECT_EQ(classifier.classify(200, 30, 40), PixelClass::kRed);
+  EXPECT_EQ(classifier.classify(40, 160, 70), PixelClass::kGreen);
+  EXPECT_EQ(classifier.classify(25, 25, 25), PixelClass::kDark);
+  EXPECT_EQ(classifier.classify(215, 215, 205), PixelClass::kBackground);
+  EXPECT_EQ(classifier.classify(170, 170, 170), PixelClass::kBackground);
+  EXPECT_EQ(classifier.classify(255, 255, 255), PixelClass::kBackground);
+}
+
+TEST_F(ColorClassifierTest, ValueDoesNotChangeTheColour) {
+  // Hue and saturation define the colour; a darker or brighter print of it
+  // (above the dark level) stays that colour.
+  for (double scale : {0.6, 0.8, 1.0, 1.2}) {
+    auto level = [scale](int v) { return static_cast<uint8_t>(std::min(255.0, v * scale)); };
+    EXPECT_EQ(classifier.classify(level(200), level(30), level(40)), PixelClass::kRed) << scale;
+    EXPECT_EQ(classifier.classify(level(40), level(160), level(70)), PixelClass::kGreen) << scale;
+  }
+}
+
+TEST_F(ColorClassifierTest, SharedEdgePixelGoesToTheColourCoveringMore) {
+  auto mix = [](double red_share, int r, int g) {
+    return static_cast<uint8_t>(std::lround(red_share * r + (1.0 - red_share) * g));
+  };
+  EXPECT_EQ(classifier.classify(mix(0.7, 200, 40), mix(0.7, 30, 160), mix(0.7, 40, 70)),
+            PixelClass::kRed);
+  EXPECT_EQ(classifier.classify(mix(0.3, 200, 40), mix(0.3, 30, 160), mix(0.3, 40, 70)),
+            PixelClass::kGreen);
+}
+
+TEST_F(ColorClassifierTest, ColourCastIsNormalisedAwayByTheTileReference) {
+  // A strong blue cast: the tile reads bluish and the red rectangle purple.
+  test::Lighting cast;
+  cast.cast = {0.75, 1.0, 1.25};
+  test::CraftedMarker marker;
+  marker.centre_u_px = 160.0;
+  marker.centre_v_px = 120.0;
+  const Image frame = test::render_markers(320, 240, std::span(&marker, 1), layout, cast);
+  ASSERT_TRUE(classifier.adapt(frame.view()));
+  EXPECT_LT(classifier.gains()[2], classifier.gains()[0]);
+  // With West image down, East (the red rectangle) is image up.
+  uint8_t r = 0, g = 0, b = 0;
+  read_rgb(frame.view(), 160, 120 - 15, &r, &g, &b);
+  EXPECT_EQ(classifier.classify(r, g, b), PixelClass::kRed);
+  read_rgb(frame.view(), 160, 120 + 15, &r, &g, &b);
+  EXPECT_EQ(classifier.classify(r, g, b), PixelClass::kGreen);
+  read_rgb(frame.view(), 20, 20, &r, &g, &b);
+  EXPECT_EQ(classifier.classify(r, g, b), PixelClass::kBackground);
+}
+
+TEST_F(ColorClassifierTest, AdaptKeepsThePreviousGainsOnAFrameWithoutTile) {
+  Image black(64, 48, PixelFormat::kRgb24);
+  const auto before = classifier.gains();
+  EXPECT_FALSE(classifier.adapt(black.view()));
+  EXPECT_EQ(classifier.gains(), before);
+}
+
+TEST_F(ColorClassifierTest, YuyvReadsBackThePrintedColours) {
+  for (Rgb c : {layout.red, layout.green, layout.tile}) {
+    Image rgb(2, 1, PixelFormat::kRgb24);
+    test::put_rgb(&rgb, 0, 0, c);
+    test::put_rgb(&rgb, 1, 0, c);
+    const Image yuyv = test::convert_rgb(rgb, PixelFormat::kYuyv);
+    uint8_t r = 0, g = 0, b = 0;
+    read_rgb(yuyv.view(), 1, 0, &r, &g, &b);
+    EXPECT_NEAR(r, c.r, 2);
+    EXPECT_NEAR(g, c.g, 2);
+    EXPECT_NEAR(b, c.b, 2);
+  }
+}
+
+TEST_F(ColorClassifierTest, GreyPixelsAreNeverRedOrGreen) {
+  for (int v = 0; v < 256; ++v) {
+    const auto c = static_cast<uint8_t>(v);
+    const PixelClass k = classifier.classify(c, c, c);
+    EXPECT_TRUE(k == PixelClass::kBackground || k == PixelClass::kDark) << v;
+  }
+}
+
+}  // namespace
+}  // namespace ceilpose

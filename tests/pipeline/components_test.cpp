@@ -1,0 +1,157 @@
+#include "pipeline/components.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <numbers>
+#include <random>
+
+#include "tests/pipeline/detect_scene_support.h"
+
+namespace ceilpose {
+namespace {
+
+constexpr Rgb kRed{200, 30, 40};
+constexpr Rgb kGreen{40, 160, 70};
+constexpr Rgb kDot{25, 25, 25};
+
+class ComponentsTest : public ::testing::Test {
+ protected:
+  static constexpr int kWidth = 120;
+  static constexpr int kHeight = 90;
+  ComponentsTest() : frame(kWidth, kHeight, PixelFormat::kRgb24) {
+    for (int y = 0; y < kHeight; ++y)
+      for (int x = 0; x < kWidth; ++x) test::put_rgb(&frame, x, y, layout.tile);
+  }
+  void fill(int x0, int y0, int x1, int y1, Rgb c) {
+    for (int y = y0; y <= y1; ++y)
+      for (int x = x0; x <= x1; ++x) test::put_rgb(&frame, x, y, c);
+  }
+  std::span<const Component> label() {
+    EXPECT_TRUE(labeler.label(frame.view(), classifier));
+    return labeler.components();
+  }
+
+  CeilingLayout layout;
+  DetectorParams params;
+  ColorClassifier classifier{params, layout.tile};
+  ComponentLabeler labeler{kWidth, kHeight, params};
+  Image frame;
+};
+
+TEST_F(ComponentsTest, FilledRectangleHasExactAreaCentroidAndMoments) {
+  fill(10, 20, 29, 59, kRed);  // 20 x 40
+  const auto comps = label();
+  ASSERT_EQ(comps.size(), 1u);
+  const Component& c = comps[0];
+  EXPECT_EQ(c.cls, PixelClass::kRed);
+  EXPECT_EQ(c.area_px, 800);
+  EXPECT_DOUBLE_EQ(c.cx, 19.5);
+  EXPECT_DOUBLE_EQ(c.cy, 39.5);
+  // Discrete variance of n consecutive integers: (n² − 1) / 12.
+  EXPECT_NEAR(c.mu20, (20.0 * 20.0 - 1.0) / 12.0, 1e-9);
+  EXPECT_NEAR(c.mu02, (40.0 * 40.0 - 1.0) / 12.0, 1e-9);
+  EXPECT_NEAR(c.mu11, 0.0, 1e-9);
+  EXPECT_EQ(c.x_min, 10);
+  EXPECT_EQ(c.y_max, 59);
+  EXPECT_FALSE(c.touches_border);
+}
+
+TEST_F(ComponentsTest, DiagonalNeighboursAreOneComponent) {
+  fill(10, 10, 10, 10, kGreen);
+  fill(11, 11, 11, 11, kGreen);
+  fill(10, 12, 10, 12, kGreen);
+  const auto comps = label();
+  ASSERT_EQ(comps.size(), 1u);
+  EXPECT_EQ(comps[0].area_px, 3);
+}
+
+TEST_F(ComponentsTest, UShapeJoinsThroughItsBottom) {
+  // The two arms are separate components until the bottom row joins them:
+  // union-find must merge labels already given.
+  fill(10, 10, 14, 40, kRed);
+  fill(30, 10, 34, 40, kRed);
+  fill(10, 41, 34, 45, kRed);
+  const auto comps = label();
+  ASSERT_EQ(comps.size(), 1u);
+  EXPECT_EQ(comps[0].area_px, 2 * 5 * 31 + 25 * 5);
+}
+
+TEST_F(ComponentsTest, TouchingRedAndGreenStaySeparate) {
+  fill(10, 10, 29, 49, kRed);
+  fill(30, 10, 49, 49, kGreen);
+  const auto comps = label();
+  ASSERT_EQ(comps.size(), 2u);
+  EXPECT_NE(comps[0].cls, comps[1].cls);
+  EXPECT_EQ(comps[0].area_px, 800);
+  EXPECT_EQ(comps[1].area_px, 800);
+}
+
+TEST_F(ComponentsTest, EnclosedDotCountsTowardsItsRectangle) {
+  fill(10, 20, 29, 59, kRed);
+  fill(15, 30, 24, 34, kDot);  // inside, margins on every side
+  const auto comps = label();
+  ASSERT_EQ(comps.size(), 1u);
+  EXPECT_EQ(comps[0].area_px, 800);
+  EXPECT_EQ(comps[0].dark_px, 50);
+  EXPECT_DOUBLE_EQ(comps[0].cx, 19.5);
+  EXPECT_DOUBLE_EQ(comps[0].cy, 39.5);
+}
+
+TEST_F(ComponentsTest, DarkBlobBesideARectangleIsNotPartOfIt) {
+  fill(10, 20, 29, 59, kRed);
+  fill(30, 30, 39, 34, kDot);  // touches the rectangle on its left side only
+  const auto comps = label();
+  ASSERT_EQ(comps.size(), 1u);
+  EXPECT_EQ(comps[0].area_px, 800);
+  EXPECT_EQ(comps[0].dark_px, 0);
+}
+
+TEST_F(ComponentsTest, BorderContactIsFlagged) {
+  fill(0, 20, 9, 29, kRed);
+  const auto comps = label();
+  ASSERT_EQ(comps.size(), 1u);
+  EXPECT_TRUE(comps[0].touches_border);
+}
+
+TEST_F(ComponentsTest, RotatedRectangleGivesItsOrientation) {
+  // Orientation from tan 2θ = 2 mu11 / (mu20 − mu02), image axes.
+  for (double deg : {-60.0, -20.0, 0.0, 25.0, 45.0, 80.0}) {
+    const double a = deg * std::numbers::pi / 180.0;
+    const double ca = std::cos(a), sa = std::sin(a);
+    fill(0, 0, kWidth - 1, kHeight - 1, layout.tile);
+    for (int y = 0; y < kHeight; ++y) {
+      for (int x = 0; x < kWidth; ++x) {
+        const double dx = x - 60.0, dy = y - 45.0;
+        if (std::abs(ca * dx + sa * dy) <= 30.0 && std::abs(-sa * dx + ca * dy) <= 8.0)
+          test::put_rgb(&frame, x, y, kGreen);
+      }
+    }
+    const auto comps = label();
+    ASSERT_EQ(comps.size(), 1u) << deg;
+    EXPECT_NEAR(comps[0].orientation_rad(), a, 0.01) << deg;
+  }
+}
+
+TEST_F(ComponentsTest, GreyFrameHasNoComponents) {
+  fill(10, 20, 29, 59, kRed);
+  const Image grey = test::convert_rgb(frame, PixelFormat::kGray8);
+  EXPECT_TRUE(labeler.label(grey.view(), classifier));
+  EXPECT_TRUE(labeler.components().empty());
+}
+
+TEST_F(ComponentsTest, NoiseBeyondTheRunBudgetAbandonsTheFrame) {
+  std::mt19937 rng(3);
+  for (int y = 0; y < kHeight; ++y)
+    for (int x = 0; x < kWidth; ++x) test::put_rgb(&frame, x, y, (rng() & 1) ? kRed : kGreen);
+  EXPECT_FALSE(labeler.label(frame.view(), classifier));
+  EXPECT_TRUE(labeler.components().empty());
+}
+
+TEST_F(ComponentsTest, FrameOfAnotherSizeIsRefused) {
+  Image other(kWidth + 2, kHeight, PixelFormat::kRgb24);
+  EXPECT_FALSE(labeler.label(other.view(), classifier));
+}
+
+}  // namespace
+}  // namespace ceilpose

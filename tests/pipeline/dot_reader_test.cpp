@@ -1,0 +1,103 @@
+#include "pipeline/dot_reader.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <numbers>
+
+#include "tests/pipeline/detect_scene_support.h"
+
+namespace ceilpose {
+namespace {
+
+// The marker frame a perfect detection of `m` gives: rectangle centres and
+// sides exactly as drawn.
+MarkerFrame frame_of(const test::CraftedMarker& m, const CeilingLayout& layout) {
+  const double s = test::kDefaultPxPerM;
+  const double wu = std::cos(m.west_image_rad), wv = std::sin(m.west_image_rad);
+  RectangleCandidate red, green;
+  red.long_px = green.long_px = layout.rect_height_m * s;
+  red.area_px = green.area_px = 1.0;
+  red.axis_rad = green.axis_rad = m.west_image_rad + 0.5 * std::numbers::pi;
+  const double half_px = 0.5 * layout.rect_width_m * s;
+  red.cx = m.centre_u_px - half_px * wu;
+  red.cy = m.centre_v_px - half_px * wv;
+  green.cx = m.centre_u_px + half_px * wu;
+  green.cy = m.centre_v_px + half_px * wv;
+  return marker_frame(red, green, layout);
+}
+
+class DotReaderTest : public ::testing::Test {
+ protected:
+  CeilingLayout layout;
+  DetectorParams params;
+};
+
+TEST_F(DotReaderTest, AtYawZeroNorthIsImageRightAndEastImageUp) {
+  // SPEC §3 at yaw 0: Xc (image right) = North, Yc (image down) = West.
+  test::CraftedMarker m;
+  const MarkerFrame f = frame_of(m, layout);
+  EXPECT_NEAR(f.west_image_rad, 0.5 * std::numbers::pi, 1e-12);
+  EXPECT_GT(f.north_u, 0.0);
+  EXPECT_NEAR(f.north_v, 0.0, 1e-9);
+  EXPECT_NEAR(f.east_u, 0.0, 1e-9);
+  EXPECT_LT(f.east_v, 0.0);
+  EXPECT_NEAR(std::hypot(f.north_u, f.north_v), test::kDefaultPxPerM, 1e-6);
+}
+
+TEST_F(DotReaderTest, EveryCodeReadsBackMsbNorthernmost) {
+  for (int i = 0; i < layout.codes(); ++i) {
+    for (int j = 0; j < layout.codes(); ++j) {
+      test::CraftedMarker m;
+      m.centre_u_px = 160.2;
+      m.centre_v_px = 119.7;
+      m.code_i = i;
+      m.code_j = j;
+      m.west_image_rad = 0.3;
+      const Image image = test::render_markers(320, 240, std::span(&m, 1), layout);
+      const MarkerFrame f = frame_of(m, layout);
+      const CodeReading ci = read_code(image.view(), f, true, layout, params);
+      const CodeReading cj = read_code(image.view(), f, false, layout, params);
+      ASSERT_TRUE(ci.ok && cj.ok);
+      EXPECT_EQ(ci.code, i) << i << "," << j;
+      EXPECT_EQ(cj.code, j) << i << "," << j;
+      EXPECT_GT(std::min(ci.margin, cj.margin), 0.2f);
+    }
+  }
+}
+
+TEST_F(DotReaderTest, SingleDotInTheNorthSlotIsTheMostSignificantBit) {
+  test::CraftedMarker m;
+  m.centre_u_px = 160.2;
+  m.centre_v_px = 119.7;
+  m.code_i = 4;  // 100: only the northernmost slot
+  m.code_j = 1;  // 001: only the southernmost
+  const Image image = test::render_markers(320, 240, std::span(&m, 1), layout);
+  const CodeReading ci = read_code(image.view(), frame_of(m, layout), true, layout, params);
+  ASSERT_TRUE(ci.ok);
+  EXPECT_LT(ci.ratio[0], 0.5f);
+  EXPECT_GT(ci.ratio[1], 0.9f);
+  EXPECT_GT(ci.ratio[2], 0.9f);
+}
+
+TEST_F(DotReaderTest, MarkerReachingOutOfTheFrameIsNotRead) {
+  test::CraftedMarker m;
+  m.centre_u_px = 10.0;
+  m.centre_v_px = 120.0;
+  const Image image = test::render_markers(320, 240, std::span(&m, 1), layout);
+  EXPECT_FALSE(read_code(image.view(), frame_of(m, layout), false, layout, params).ok);
+}
+
+TEST_F(DotReaderTest, DarkAreaBeyondTheCodesDotsIsInconsistent) {
+  const double s = test::kDefaultPxPerM;
+  RectangleCandidate r;
+  r.area_px = layout.rect_width_m * layout.rect_height_m * s * s;
+  const double red_dot_px =
+      0.25 * std::numbers::pi * layout.red_dot_e_m * layout.red_dot_n_m * s * s;
+  r.dark_px = 2.0 * red_dot_px;
+  EXPECT_TRUE(dark_area_consistent(r, 3, true, layout, s));   // two dots: fits
+  EXPECT_FALSE(dark_area_consistent(r, 0, true, layout, s));  // no dots: dirt
+}
+
+}  // namespace
+}  // namespace ceilpose
