@@ -83,10 +83,10 @@ MarkerFrame marker_frame(const RectangleCandidate& red, const RectangleCandidate
   // West is perpendicular to the long axes, on the green side. The axes,
   // measured along 12 in edges, fix the direction about ten times better
   // than the 5 in red→green baseline, which only gives the sign.
-  const double c2 = red.area_px * std::cos(2.0 * red.axis_rad) +
-                    green.area_px * std::cos(2.0 * green.axis_rad);
-  const double s2 = red.area_px * std::sin(2.0 * red.axis_rad) +
-                    green.area_px * std::sin(2.0 * green.axis_rad);
+  const double c2 =
+      red.area_px * std::cos(2.0 * red.axis_rad) + green.area_px * std::cos(2.0 * green.axis_rad);
+  const double s2 =
+      red.area_px * std::sin(2.0 * red.axis_rad) + green.area_px * std::sin(2.0 * green.axis_rad);
   const double axis_rad = 0.5 * std::atan2(s2, c2);
   double a = -std::sin(axis_rad), b = std::cos(axis_rad);
   if (a * (green.cx - red.cx) + b * (green.cy - red.cy) < 0.0) a = -a, b = -b;
