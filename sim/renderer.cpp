@@ -29,6 +29,18 @@ struct CeilingMap {
 
 }  // namespace
 
+CameraIntrinsics scaled_default_intrinsics(int width_px) {
+  CameraIntrinsics k;
+  const double scale = width_px / static_cast<double>(k.width);
+  k.width = width_px;
+  k.height = width_px * 3 / 4;
+  k.fx *= scale;
+  k.fy *= scale;
+  k.cx = 0.5 * (k.width - 1);
+  k.cy = 0.5 * (k.height - 1);
+  return k;
+}
+
 Renderer::Renderer(const SceneOptions& options)
     : options_(options), scene_(options.layout, options.seed) {
   const CameraIntrinsics& k = options_.intrinsics;

@@ -26,6 +26,11 @@ struct SceneOptions {
   uint64_t seed = 1;  // places fixtures and clutter; seeds the per-frame noise
 };
 
+// SPEC's default camera (640 x 480, fx = fy = 530) resized to `width_px`
+// wide, 4:3, with the same field of view: the focal length scales with the
+// width. For benchmarks and tests at 320 x 240, 1280 x 960, ...
+CameraIntrinsics scaled_default_intrinsics(int width_px);
+
 // Sub-samples per axis of a pixel that straddles an edge.
 inline constexpr int kSupersamplePerAxis = 4;
 

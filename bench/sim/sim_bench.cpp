@@ -9,20 +9,9 @@
 namespace ceilpose::sim {
 namespace {
 
-SceneOptions options_for(int width_px) {
-  // Same field of view at every resolution: focal length scales with width.
-  SceneOptions o;
-  const double scale = width_px / 640.0;
-  o.intrinsics.width = width_px;
-  o.intrinsics.height = width_px * 3 / 4;
-  o.intrinsics.fx = o.intrinsics.fy = 530.0 * scale;
-  o.intrinsics.cx = 0.5 * (o.intrinsics.width - 1);
-  o.intrinsics.cy = 0.5 * (o.intrinsics.height - 1);
-  return o;
-}
-
 void run(benchmark::State& state, const char* scenario_name) {
-  const SceneOptions options = options_for(static_cast<int>(state.range(0)));
+  SceneOptions options;
+  options.intrinsics = scaled_default_intrinsics(static_cast<int>(state.range(0)));
   Renderer renderer(options);
   const Result<Scenario> scenario = make_scenario(scenario_name, options, 64, 5);
   if (!scenario) {

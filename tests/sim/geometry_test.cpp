@@ -200,5 +200,16 @@ TEST(RendererGeometry, WholeMarkerCentroidsLandWhereProjectionSaysForEveryMarker
   EXPECT_GE(checked, 4);
 }
 
+TEST(RendererGeometry, ScaledDefaultCameraKeepsTheFieldOfView) {
+  const CameraIntrinsics k = scaled_default_intrinsics(1280);
+  const CameraIntrinsics d;
+  EXPECT_EQ(k.width, 1280);
+  EXPECT_EQ(k.height, 960);
+  EXPECT_DOUBLE_EQ(k.fx, 2 * d.fx);
+  EXPECT_DOUBLE_EQ(k.cx, 639.5);
+  EXPECT_DOUBLE_EQ(k.cy, 479.5);
+  EXPECT_DOUBLE_EQ(k.width / k.fx, d.width / d.fx);
+}
+
 }  // namespace
 }  // namespace ceilpose::sim
