@@ -66,7 +66,10 @@ struct DetectorParams {
   // Relative tolerance on the red–green centre distance (nominal: the
   // rectangle width, 5 in) and on the area ratio of the two rectangles.
   float pair_distance_tolerance = 0.3f;
-  float pair_area_tolerance = 0.45f;
+  float pair_area_tolerance = 0.3f;
+  // Relative tolerance on the two long sides: both rectangles span the same
+  // 12 in, so a rectangle cut short by an occluder or glare differs.
+  float pair_length_tolerance = 0.12f;
   // Largest angle (rad) between the two long axes, and between the
   // red→green vector and the normal of the red long axis.
   float pair_angle_tolerance_rad = 0.25f;

@@ -7,8 +7,8 @@
 // Two rectangles of one marker share a long edge, so (SPEC §2): their long
 // axes are parallel, the vector between their centres is perpendicular to
 // them and as long as one rectangle is wide (5 in, i.e. 5/12 of the long
-// side measured in the same image), and their areas are equal. Every
-// red/green combination that passes all four tests within tolerance is a
+// side measured in the same image), and their areas and long sides are
+// equal. Every red/green combination that passes all five tests within tolerance is a
 // candidate; candidates are taken best score first, each rectangle once, so
 // a clutter blob next to a marker cannot steal its partner from a better fit.
 
@@ -51,6 +51,8 @@ int MarkerPairer::pair(std::span<const RectangleCandidate> rects, const CeilingL
       if (dist_err > params.pair_distance_tolerance) continue;
       const double area_err = std::abs(red.area_px / green.area_px - 1.0);
       if (area_err > params.pair_area_tolerance) continue;
+      const double length_err = std::abs(red.long_px / green.long_px - 1.0);
+      if (length_err > params.pair_length_tolerance) continue;
       const double parallel_err = std::abs(axis_difference_rad(red.axis_rad, green.axis_rad));
       if (parallel_err > params.pair_angle_tolerance_rad) continue;
       const double along = std::abs(du * ax + dv * ay) / dist;  // sine of the off-normal angle
