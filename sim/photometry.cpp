@@ -70,17 +70,6 @@ struct FastRng {
   double uniform() { return static_cast<double>(next() >> 11) * 0x1.0p-53; }
 };
 
-inline float sample_bilinear(const float* img, int w, int h, float x, float y, int ch) {
-  x = std::clamp(x, 0.0f, static_cast<float>(w - 1));
-  y = std::clamp(y, 0.0f, static_cast<float>(h - 1));
-  const int x0 = static_cast<int>(x), y0 = static_cast<int>(y);
-  const int x1 = std::min(x0 + 1, w - 1), y1 = std::min(y0 + 1, h - 1);
-  const float fx = x - x0, fy = y - y0;
-  const float a = img[(y0 * w + x0) * 3 + ch], b = img[(y0 * w + x1) * 3 + ch];
-  const float c = img[(y1 * w + x0) * 3 + ch], d = img[(y1 * w + x1) * 3 + ch];
-  return (a + (b - a) * fx) * (1 - fy) + (c + (d - c) * fx) * fy;
-}
-
 }  // namespace
 
 Photometry::Photometry() : encode_u8_(kEncodeSize), encode_f_(kEncodeSize) {
@@ -197,21 +186,30 @@ void Photometry::gaussian_blur(float* img, float* tmp, int w, int h, double sigm
 
 void Photometry::motion_blur(float* linear, double length_px, double angle_rad) {
   // Average of the image sampled at evenly spaced points along the motion
-  // segment; a constant shift has the same bilinear weights at every pixel.
+  // segment. A constant shift has the same bilinear weights at every pixel,
+  // so each tap is four shifted, weighted copies of the image.
   const int taps = std::max(2, static_cast<int>(std::ceil(length_px)) + 1);
-  const float dx = static_cast<float>(length_px * std::cos(angle_rad));
-  const float dy = static_cast<float>(length_px * std::sin(angle_rad));
-  const float weight = 1.0f / taps;
+  const double dx = length_px * std::cos(angle_rad), dy = length_px * std::sin(angle_rad);
+  const int w = width_px_, h = height_px_;
   std::fill(scratch_.begin(), scratch_.end(), 0.0f);
   for (int k = 0; k < taps; ++k) {
-    const float s = static_cast<float>(k) / (taps - 1) - 0.5f;
-    const float ox = s * dx, oy = s * dy;
-    for (int y = 0; y < height_px_; ++y) {
-      float* dst = scratch_.data() + static_cast<size_t>(y) * width_px_ * 3;
-      for (int x = 0; x < width_px_; ++x)
+    const double s = static_cast<double>(k) / (taps - 1) - 0.5;
+    const double ox = s * dx, oy = s * dy;
+    const int ix = static_cast<int>(std::floor(ox)), iy = static_cast<int>(std::floor(oy));
+    const float fx = static_cast<float>(ox - ix), fy = static_cast<float>(oy - iy);
+    const float wt = 1.0f / taps;
+    const float w00 = wt * (1 - fx) * (1 - fy), w10 = wt * fx * (1 - fy);
+    const float w01 = wt * (1 - fx) * fy, w11 = wt * fx * fy;
+    for (int y = 0; y < h; ++y) {
+      const float* s0 = linear + static_cast<size_t>(std::clamp(y + iy, 0, h - 1)) * w * 3;
+      const float* s1 = linear + static_cast<size_t>(std::clamp(y + iy + 1, 0, h - 1)) * w * 3;
+      float* dst = scratch_.data() + static_cast<size_t>(y) * w * 3;
+      for (int x = 0; x < w; ++x) {
+        const int c0 = std::clamp(x + ix, 0, w - 1) * 3, c1 = std::clamp(x + ix + 1, 0, w - 1) * 3;
         for (int c = 0; c < 3; ++c)
           dst[x * 3 + c] +=
-              weight * sample_bilinear(linear, width_px_, height_px_, x + ox, y + oy, c);
+              w00 * s0[c0 + c] + w10 * s0[c1 + c] + w01 * s1[c0 + c] + w11 * s1[c1 + c];
+      }
     }
   }
   std::copy(scratch_.begin(), scratch_.end(), linear);
@@ -232,14 +230,25 @@ void Photometry::add_bloom(float* linear, double strength) {
   const float norm = 1.0f / (f * f);
   for (float& v : small_) v *= norm;
   gaussian_blur(small_.data(), small_scratch_.data(), sw, sh, kBloomSigmaPerWidth * width_px_ / f);
+  // Bilinear upsampling; sample centres of the small image sit at
+  // f * (i + 0.5) - 0.5 in full-resolution pixels.
   const float k = static_cast<float>(strength);
   for (int y = 0; y < height_px_; ++y) {
     float* dst = linear + static_cast<size_t>(y) * width_px_ * 3;
-    const float sy = (y + 0.5f) / f - 0.5f;
+    const float sy = std::clamp((y + 0.5f) / f - 0.5f, 0.0f, static_cast<float>(sh - 1));
+    const int y0 = static_cast<int>(sy), y1 = std::min(y0 + 1, sh - 1);
+    const float fy = sy - y0;
+    const float* r0 = small_.data() + static_cast<size_t>(y0) * sw * 3;
+    const float* r1 = small_.data() + static_cast<size_t>(y1) * sw * 3;
     for (int x = 0; x < width_px_; ++x) {
-      const float sx = (x + 0.5f) / f - 0.5f;
-      for (int c = 0; c < 3; ++c)
-        dst[x * 3 + c] += k * sample_bilinear(small_.data(), sw, sh, sx, sy, c);
+      const float sx = std::clamp((x + 0.5f) / f - 0.5f, 0.0f, static_cast<float>(sw - 1));
+      const int x0 = static_cast<int>(sx), x1 = std::min(x0 + 1, sw - 1);
+      const float fx = sx - x0;
+      for (int c = 0; c < 3; ++c) {
+        const float top = r0[x0 * 3 + c] + (r0[x1 * 3 + c] - r0[x0 * 3 + c]) * fx;
+        const float bottom = r1[x0 * 3 + c] + (r1[x1 * 3 + c] - r1[x0 * 3 + c]) * fx;
+        dst[x * 3 + c] += k * (top + (bottom - top) * fy);
+      }
     }
   }
 }

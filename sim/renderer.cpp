@@ -76,7 +76,10 @@ void Renderer::render(const Pose2D& robot, const CameraMount& mount, const Effec
   // material's colour, and a pixel that straddles an edge averages an N x N
   // grid of sub-samples in linear light. Sub-sample rays are bilinear in the
   // pixel's four corner rays: the distortion is smooth, so the error of that
-  // interpolation over one pixel is far below 1e-3 px.
+  // interpolation over one pixel is far below 1e-3 px. The corner test
+  // assumes no feature fits between corners: the thinnest SPEC feature (red
+  // dot, rail: 1 in) spans about 3 px even at 320 x 240. Measured centroid
+  // error of rendered rectangles: about 0.003 px (tests/sim geometry_test).
   const int w = options_.intrinsics.width, h = options_.intrinsics.height, cw = w + 1;
   const CeilingMap map(camera_pose_from_robot(robot, mount), options_.layout.height_m);
   const bool fixtures = effects.light_fixtures;
