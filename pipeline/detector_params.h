@@ -85,6 +85,11 @@ struct DetectorParams {
   // partial occlusion; must stay below pitch − dot height (2 in by default).
   // Cost: one line of three samples per pixel searched.
   double dot_search_m = 0.0254;
+  // A marker is not decoded when any slot reads closer than this to
+  // dot_threshold_ratio: a dot washed out by blur would otherwise read as
+  // unset and give a valid-looking wrong code. Lower it to trade wrong
+  // codes for availability.
+  float dot_min_margin = 0.1f;
 };
 
 }  // namespace ceilpose

@@ -89,6 +89,10 @@ bool Pipeline::decode(const ImageView& frame, const MarkerPair& pair, MarkerObse
     ++counters_.unreadable_codes;
     return false;
   }
+  if (std::min(code_i.margin, code_j.margin) < config_.detector.dot_min_margin) {
+    ++counters_.ambiguous_codes;
+    return false;
+  }
   const double px_per_m = std::hypot(m.north_u, m.north_v);
   if (code_i.code >= layout.codes() || code_j.code >= layout.codes() ||
       !dark_area_consistent(red, code_i.code, true, layout, px_per_m) ||
