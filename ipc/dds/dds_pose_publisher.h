@@ -40,6 +40,9 @@ class DdsPosePublisher {
   const std::string& pose_topic() const { return pose_topic_; }
   const std::string& status_topic() const { return status_topic_; }
   uint32_t domain_id() const { return participant_.domain_id(); }
+  // For entities that should share this participant (one participant per
+  // process is the cheapest for discovery); 0 after dispose().
+  dds_entity_t participant_handle() const { return participant_.handle(); }
   uint64_t published() const { return published_; }
   uint64_t skipped_invalid() const { return skipped_invalid_; }
 

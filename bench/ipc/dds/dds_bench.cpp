@@ -154,15 +154,13 @@ void pong_on_data(dds_entity_t reader, void* arg) {
 
 int run_pong(uint32_t domain_id) {
   auto pub = DdsPosePublisher::create(bench_options(kPongRobot, domain_id));
-  auto rp = DdsParticipant::create(bench_options(kPingRobot, domain_id).domain);
-  if (!pub || !rp) {
-    std::fprintf(stderr, "dds_bench --pong: %s\n",
-                 (!pub ? pub.error() : rp.error()).message.c_str());
+  if (!pub) {
+    std::fprintf(stderr, "dds_bench --pong: %s\n", pub.error().message.c_str());
     return 1;
   }
   Pong pong;
   pong.pub = &*pub;
-  PoseReader reader(rp->handle(), kPingRobot, &pong_on_data, &pong);
+  PoseReader reader(pub->participant_handle(), kPingRobot, &pong_on_data, &pong);
   if (!reader.ok()) return 1;
   std::printf("ready\n");
   std::fflush(stdout);
@@ -174,16 +172,27 @@ int run_pong(uint32_t domain_id) {
 
 // --- ping side ---------------------------------------------------------------
 
-class PongProcess {
+// The pong process and this side's publisher; readers are added to the
+// publisher's participant, one participant per process as in ddsperf.
+class PingSide {
  public:
-  explicit PongProcess(uint32_t domain_id)
-      : child_({"/proc/self/exe", "--pong", std::to_string(domain_id)}) {}
-  bool ready() {
-    return child_.read_until("ready", kMatchTimeoutMs).find("ready") != std::string::npos;
+  explicit PingSide(uint32_t domain_id)
+      : pong_({"/proc/self/exe", "--pong", std::to_string(domain_id)}),
+        pub_(DdsPosePublisher::create(bench_options(kPingRobot, domain_id))) {}
+
+  // Null when ready, else what went wrong.
+  const char* setup_error() {
+    if (pong_.read_until("ready", kMatchTimeoutMs).find("ready") == std::string::npos) {
+      return "pong process did not start";
+    }
+    return pub_.ok() ? nullptr : "cannot create the DDS publisher";
   }
+  DdsPosePublisher& pub() { return *pub_; }
+  dds_entity_t participant() const { return pub_->participant_handle(); }
 
  private:
-  test::ChildProcess child_;
+  test::ChildProcess pong_;
+  Result<DdsPosePublisher> pub_;
 };
 
 // Round trips driven from the listener: each echo sends the next ping.
@@ -232,18 +241,14 @@ void ping_on_data(dds_entity_t reader, void* arg) {
 }
 
 void BM_DdsPoseRoundTrip(benchmark::State& state) {
-  const uint32_t domain_id = test::unique_domain_id();
-  PongProcess pong(domain_id);
-  if (!pong.ready()) return state.SkipWithError("pong process did not start");
-  auto pub = DdsPosePublisher::create(bench_options(kPingRobot, domain_id));
-  auto rp = DdsParticipant::create(bench_options(kPongRobot, domain_id).domain);
-  if (!pub || !rp) return state.SkipWithError("cannot create DDS entities");
+  PingSide side(test::unique_domain_id());
+  if (const char* error = side.setup_error()) return state.SkipWithError(error);
   PingChain chain;
-  chain.pub = &*pub;
+  chain.pub = &side.pub();
   chain.ping.valid = true;
   chain.rtt_us.reserve(1 << 22);
   chain.sent_at_ns.reserve(1 << 22);
-  PoseReader reader(rp->handle(), kPongRobot, &ping_on_data, &chain);
+  PoseReader reader(side.participant(), kPongRobot, &ping_on_data, &chain);
   // Discovery: a reliable writer drops what it writes before it has matched
   // the pong's reader, so ping until an echo comes back.
   const int64_t match_deadline_ns = monotonic_ns() + kMatchTimeoutMs * 1'000'000;
@@ -275,13 +280,10 @@ void BM_DdsPoseRoundTrip(benchmark::State& state) {
 BENCHMARK(BM_DdsPoseRoundTrip)->MinTime(5.0)->Unit(benchmark::kMillisecond)->UseRealTime();
 
 void BM_DdsPoseRoundTripWaitset(benchmark::State& state) {
-  const uint32_t domain_id = test::unique_domain_id();
-  PongProcess pong(domain_id);
-  if (!pong.ready()) return state.SkipWithError("pong process did not start");
-  auto pub = DdsPosePublisher::create(bench_options(kPingRobot, domain_id));
-  auto rp = DdsParticipant::create(bench_options(kPongRobot, domain_id).domain);
-  if (!pub || !rp) return state.SkipWithError("cannot create DDS entities");
-  PoseReader reader(rp->handle(), kPongRobot, nullptr, nullptr);
+  PingSide side(test::unique_domain_id());
+  if (const char* error = side.setup_error()) return state.SkipWithError(error);
+  DdsPosePublisher* pub = &side.pub();
+  PoseReader reader(side.participant(), kPongRobot, nullptr, nullptr);
   DdsPose ping;
   ping.valid = true;
   DdsPose echo;

@@ -1,0 +1,183 @@
+// ceilpose_fastdds_pose_listener: another vendor's subscriber (eProsima Fast
+// DDS, Debian's libfastrtps) for the interoperability test. It knows the
+// message only as ROS 2's rmw_fastrtps does: by the type name and the XCDR1
+// field layout, decoded by hand with Fast CDR; nothing is shared with
+// Cyclone or with ceilpose's generated code.
+//
+// Prints one line per received sample and exits 0 after --count samples, 1
+// if --timeout-ms passes first.
+#include <fastcdr/Cdr.h>
+#include <fastcdr/FastBuffer.h>
+#include <fastdds/rtps/transport/UDPv4TransportDescriptor.h>
+#include <fastrtps/utils/IPLocator.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <fastdds/dds/domain/DomainParticipant.hpp>
+#include <fastdds/dds/domain/DomainParticipantFactory.hpp>
+#include <fastdds/dds/subscriber/DataReader.hpp>
+#include <fastdds/dds/subscriber/SampleInfo.hpp>
+#include <fastdds/dds/subscriber/Subscriber.hpp>
+#include <fastdds/dds/subscriber/qos/DataReaderQos.hpp>
+#include <fastdds/dds/topic/TopicDataType.hpp>
+#include <fastdds/dds/topic/TypeSupport.hpp>
+#include <memory>
+#include <string>
+#include <thread>
+
+namespace {
+
+namespace fdds = eprosima::fastdds::dds;
+namespace frtps = eprosima::fastrtps::rtps;
+
+struct PoseMsg {
+  int32_t sec = 0;
+  uint32_t nanosec = 0;
+  std::string frame_id;
+  double position[3] = {};
+  double orientation[4] = {};
+  double covariance[36] = {};
+};
+
+class PoseType : public fdds::TopicDataType {
+ public:
+  PoseType() {
+    setName("geometry_msgs::msg::dds_::PoseWithCovarianceStamped_");
+    m_typeSize = 4 + 8192;  // encapsulation + a generous bound (frame_id is a string)
+    m_isGetKeyDefined = false;
+  }
+
+  bool serialize(void* data, frtps::SerializedPayload_t* payload) override {
+    auto* msg = static_cast<PoseMsg*>(data);
+    eprosima::fastcdr::FastBuffer buffer(reinterpret_cast<char*>(payload->data), payload->max_size);
+    eprosima::fastcdr::Cdr cdr(buffer, eprosima::fastcdr::Cdr::DEFAULT_ENDIAN,
+                               eprosima::fastcdr::Cdr::DDS_CDR);
+    payload->encapsulation =
+        cdr.endianness() == eprosima::fastcdr::Cdr::BIG_ENDIANNESS ? CDR_BE : CDR_LE;
+    cdr.serialize_encapsulation();
+    cdr << msg->sec << msg->nanosec << msg->frame_id;
+    cdr.serializeArray(msg->position, 3);
+    cdr.serializeArray(msg->orientation, 4);
+    cdr.serializeArray(msg->covariance, 36);
+    payload->length = static_cast<uint32_t>(cdr.getSerializedDataLength());
+    return true;
+  }
+
+  bool deserialize(frtps::SerializedPayload_t* payload, void* data) override {
+    auto* msg = static_cast<PoseMsg*>(data);
+    eprosima::fastcdr::FastBuffer buffer(reinterpret_cast<char*>(payload->data), payload->length);
+    eprosima::fastcdr::Cdr cdr(buffer, eprosima::fastcdr::Cdr::DEFAULT_ENDIAN,
+                               eprosima::fastcdr::Cdr::DDS_CDR);
+    try {
+      cdr.read_encapsulation();
+      cdr >> msg->sec >> msg->nanosec >> msg->frame_id;
+      cdr.deserializeArray(msg->position, 3);
+      cdr.deserializeArray(msg->orientation, 4);
+      cdr.deserializeArray(msg->covariance, 36);
+    } catch (const std::exception& e) {
+      std::fprintf(stderr, "fastdds listener: cannot decode a sample: %s\n", e.what());
+      return false;
+    }
+    return true;
+  }
+
+  std::function<uint32_t()> getSerializedSizeProvider(void*) override {
+    return [] { return 4u + 8192u; };
+  }
+  void* createData() override { return new PoseMsg(); }
+  void deleteData(void* data) override { delete static_cast<PoseMsg*>(data); }
+  bool getKey(void*, frtps::InstanceHandle_t*, bool) override { return false; }
+};
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  int domain_id = 0;
+  std::string topic_name;
+  int count = 3;
+  long timeout_ms = 20000;
+  for (int k = 1; k + 1 < argc; k += 2) {
+    if (std::strcmp(argv[k], "--domain") == 0)
+      domain_id = std::atoi(argv[k + 1]);
+    else if (std::strcmp(argv[k], "--topic") == 0)
+      topic_name = argv[k + 1];
+    else if (std::strcmp(argv[k], "--count") == 0)
+      count = std::atoi(argv[k + 1]);
+    else if (std::strcmp(argv[k], "--timeout-ms") == 0)
+      timeout_ms = std::atol(argv[k + 1]);
+  }
+  if (topic_name.empty()) {
+    std::fprintf(stderr,
+                 "usage: %s --topic rt/<robot>/pose [--domain ID] [--count N] [--timeout-ms T]\n",
+                 argv[0]);
+    return 2;
+  }
+
+  // Loopback UDP only, discovery by unicast to the participant ports of
+  // 127.0.0.1, as the Cyclone side is configured.
+  fdds::DomainParticipantQos pqos;
+  pqos.name("ceilpose_fastdds_pose_listener");
+  pqos.transport().use_builtin_transports = false;
+  auto udp = std::make_shared<eprosima::fastdds::rtps::UDPv4TransportDescriptor>();
+  udp->interfaceWhiteList.push_back("127.0.0.1");
+  udp->maxInitialPeersRange = 41;
+  pqos.transport().user_transports.push_back(udp);
+  frtps::Locator_t peer;
+  frtps::IPLocator::setIPv4(peer, 127, 0, 0, 1);
+  pqos.wire_protocol().builtin.initialPeersList.push_back(peer);
+
+  auto* factory = fdds::DomainParticipantFactory::get_instance();
+  fdds::DomainParticipant* participant = factory->create_participant(domain_id, pqos);
+  if (participant == nullptr) {
+    std::fprintf(stderr, "fastdds listener: cannot create a participant on domain %d\n", domain_id);
+    return 1;
+  }
+  fdds::TypeSupport type(new PoseType());
+  type.register_type(participant);
+  fdds::Topic* topic =
+      participant->create_topic(topic_name, type.get_type_name(), fdds::TOPIC_QOS_DEFAULT);
+  fdds::Subscriber* subscriber = participant->create_subscriber(fdds::SUBSCRIBER_QOS_DEFAULT);
+  fdds::DataReaderQos rqos = fdds::DATAREADER_QOS_DEFAULT;
+  rqos.reliability().kind = fdds::RELIABLE_RELIABILITY_QOS;  // as ROS 2's default profile
+  rqos.history().kind = fdds::KEEP_LAST_HISTORY_QOS;
+  rqos.history().depth = 10;
+  fdds::DataReader* reader = topic != nullptr && subscriber != nullptr
+                                 ? subscriber->create_datareader(topic, rqos)
+                                 : nullptr;
+  if (reader == nullptr) {
+    std::fprintf(stderr, "fastdds listener: cannot create a reader for %s\n", topic_name.c_str());
+    return 1;
+  }
+  std::printf("ready\n");
+  std::fflush(stdout);
+
+  int received = 0;
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::milliseconds(timeout_ms);
+  while (received < count && std::chrono::steady_clock::now() < deadline) {
+    if (!reader->wait_for_unread_message(eprosima::fastrtps::Duration_t(0, 200'000'000))) continue;
+    PoseMsg msg;
+    fdds::SampleInfo info;
+    while (received < count && reader->take_next_sample(&msg, &info) == ReturnCode_t::RETCODE_OK) {
+      if (!info.valid_data) continue;
+      ++received;
+      std::printf(
+          "sample type=%s sec=%d nanosec=%u frame=%s x=%.9g y=%.9g z=%.9g qx=%.9g qy=%.9g qz=%.9g "
+          "qw=%.9g cxx=%.9g cxy=%.9g cyy=%.9g cyawyaw=%.9g czz=%.9g\n",
+          type.get_type_name().c_str(), msg.sec, msg.nanosec, msg.frame_id.c_str(), msg.position[0],
+          msg.position[1], msg.position[2], msg.orientation[0], msg.orientation[1],
+          msg.orientation[2], msg.orientation[3], msg.covariance[0], msg.covariance[1],
+          msg.covariance[7], msg.covariance[35], msg.covariance[14]);
+      std::fflush(stdout);
+    }
+  }
+  participant->delete_contained_entities();
+  factory->delete_participant(participant);
+  // Fast DDS keeps process-wide singletons alive to the end; leave without
+  // running exit handlers so that LeakSanitizer (ASan suite) judges our
+  // tests, not that library's shutdown.
+  std::fflush(stdout);
+  _exit(received >= count ? 0 : 1);
+}
