@@ -67,9 +67,7 @@ Result<RecordingCamera> parse_yaml(const std::string& path) {
   try {
     root = YAML::LoadFile(path);
   } catch (const YAML::BadFile&) {
-    std::error_code ec;
     const bool exists = std::ifstream(path).good();
-    (void)ec;
     return make_error(path +
                       (exists ? ": cannot be read" : ": missing (not a recording directory?)"));
   } catch (const YAML::ParserException& e) {
@@ -281,7 +279,9 @@ Result<RecordingReader> RecordingReader::open(const std::string& dir) {
   const std::string csv_path = r.dir_ + "/" + fmt::kCsvName;
   auto text = read_text(csv_path, "frames.csv");
   if (!text) return text.error();
-  const std::string_view all(*text);
+  std::string_view all(*text);
+  // Spreadsheet programs start CSV files with a UTF-8 byte-order mark.
+  if (all.starts_with("\xEF\xBB\xBF")) all.remove_prefix(3);
 
   std::vector<std::string> fields;
   Columns cols;
@@ -371,6 +371,7 @@ Result<RecordingReader> RecordingReader::open(const std::string& dir) {
                         "): not a regular file");
     }
     r.rows_.push_back(std::move(row));
+    r.frame_paths_.push_back(frame_path);
   }
   if (!header_seen) return make_error(csv_path + ":1: empty file, expected the header line");
   return r;
@@ -386,8 +387,7 @@ Result<void> RecordingReader::read_frame_file(size_t i) const {
     return make_error(dir_ + ": frame " + std::to_string(i) + " out of range (recording has " +
                       std::to_string(rows_.size()) + " frames)");
   }
-  const std::string path = dir_ + "/" + rows_[i].file;
-  const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
+  const int fd = ::open(frame_paths_[i].c_str(), O_RDONLY | O_CLOEXEC);
   if (fd < 0) {
     return make_error(frame_context(i) + ": cannot open frame file (" + std::strerror(errno) + ")");
   }

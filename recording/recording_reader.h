@@ -67,6 +67,7 @@ class RecordingReader {
   std::string dir_;
   RecordingCamera camera_;
   std::vector<RecordingRow> rows_;
+  std::vector<std::string> frame_paths_;  // dir_ + "/" + file, so loading builds no strings
   bool has_ground_truth_columns_ = false;
   struct Scratch;
   std::unique_ptr<Scratch> scratch_;

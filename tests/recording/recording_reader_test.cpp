@@ -110,6 +110,13 @@ TEST_F(RecordingReaderTest, AcceptsCrLfLineEndingsAndQuotedFields) {
   EXPECT_FALSE(reader_->has_ground_truth_columns());
 }
 
+TEST_F(RecordingReaderTest, AcceptsAUtf8ByteOrderMarkBeforeTheHeader) {
+  write_valid(2);
+  write_text_file(dir_ + "/frames.csv", "\xEF\xBB\xBF" + read_text_file(dir_ + "/frames.csv"));
+  ASSERT_NO_FATAL_FAILURE(open_reader());
+  EXPECT_EQ(reader_->rows().size(), 2u);
+}
+
 TEST_F(RecordingReaderTest, RowWithAllGroundTruthFieldsEmptyHasNoGroundTruth) {
   write_valid(2);
   replace_line(dir_ + "/frames.csv", 3, "1,2000000000,frames/000001.png,,,");
