@@ -16,7 +16,7 @@
 // Boehm, "Can seqlocks get along with programming language memory models?",
 // 2012). Every payload word is a relaxed std::atomic, so there is no data race
 // in the C++ sense and ThreadSanitizer can check it:
-//   writer: seq = s+1 (relaxed); fence(release); words (relaxed); seq = s+2 (release)
+//   writer: seq = s+1 (release); fence(release); words (relaxed); seq = s+2 (release)
 //   reader: s0 = seq (acquire); words (relaxed); fence(acquire); s1 = seq (relaxed);
 //           the copy is whole iff s0 is even and s0 == s1.
 // If the reader saw any word of a newer write, the release fence before that
@@ -62,7 +62,10 @@ struct alignas(64) SeqlockSlot {
     uint64_t tmp[kWords];
     std::memcpy(tmp, &value, sizeof(T));
     const uint32_t s = seq.load(std::memory_order_relaxed);
-    seq.store(s + 1, std::memory_order_relaxed);
+    // Release (not relaxed, which the seqlock alone would allow): a reader that
+    // sees this odd value also sees everything published before it, e.g.
+    // latest_seq, so falling back to the ring never goes back in time.
+    seq.store(s + 1, std::memory_order_release);
     std::atomic_thread_fence(std::memory_order_release);
     for (size_t i = 0; i < kWords; ++i) words[i].store(tmp[i], std::memory_order_relaxed);
     seq.store(s + 2, std::memory_order_release);
@@ -124,7 +127,15 @@ struct alignas(64) WakeSegment {
 
 static_assert(sizeof(SegmentHeader) == 128, "layout of docs/ipc.md");
 static_assert(offsetof(Segment, latest) == 128, "layout of docs/ipc.md");
+static_assert(offsetof(SegmentHeader, abi_version) == 8, "layout of docs/ipc.md");
+static_assert(offsetof(SegmentHeader, writer_pid) == 36, "layout of docs/ipc.md");
+static_assert(offsetof(SegmentHeader, generation) == 40, "layout of docs/ipc.md");
+static_assert(offsetof(SegmentHeader, start_real_ns) == 56, "layout of docs/ipc.md");
 static_assert(offsetof(SegmentHeader, state) == 64, "layout of docs/ipc.md");
+static_assert(offsetof(SegmentHeader, wake_seq) == 68, "layout of docs/ipc.md");
+static_assert(offsetof(SegmentHeader, heartbeat_mono_ns) == 72, "layout of docs/ipc.md");
+static_assert(offsetof(SegmentHeader, latest_seq) == 80, "layout of docs/ipc.md");
+static_assert(offsetof(Segment, ring) == 512, "layout of docs/ipc.md");
 static_assert(sizeof(SeqlockSlot<PoseRecord>) == 192, "layout of docs/ipc.md");
 static_assert(sizeof(SeqlockSlot<StatusRecord>) == 192, "layout of docs/ipc.md");
 static_assert(sizeof(Segment) == 128 + 192 * (2 + kRingLength), "layout of docs/ipc.md");

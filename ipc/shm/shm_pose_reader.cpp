@@ -43,15 +43,19 @@ std::string describe_access(const std::string& name) {
          std::to_string(::getegid()) + " (is it in the segment's group?)";
 }
 
+inline void cpu_relax() {
+#if defined(__x86_64__) || defined(__i386__)
+  __builtin_ia32_pause();
+#elif defined(__aarch64__)
+  asm volatile("yield");
+#endif
+}
+
 template <typename T, typename Slot>
 bool load_retrying(const Slot& slot, T* out) {
   for (int i = 0; i < ShmPoseReader::kReadRetries; ++i) {
     if (slot.try_load(out)) return true;
-#if defined(__x86_64__) || defined(__i386__)
-    __builtin_ia32_pause();
-#elif defined(__aarch64__)
-    asm volatile("yield");
-#endif
+    cpu_relax();
   }
   return false;
 }
@@ -281,8 +285,20 @@ ShmPoseReader& ShmPoseReader::operator=(ShmPoseReader&&) noexcept = default;
 ShmPoseReader::~ShmPoseReader() = default;
 
 ReadResult ShmPoseReader::read_latest(PoseRecord* out) const {
-  if (impl_->latest_seq() == 0) return ReadResult::kNoPose;
-  return load_retrying(impl_->seg->latest, out) ? ReadResult::kOk : ReadResult::kBusy;
+  const Impl& r = *impl_;
+  if (r.latest_seq() == 0) return ReadResult::kNoPose;
+  for (int i = 0; i < kReadRetries; ++i) {
+    if (r.seg->latest.try_load(out)) return ReadResult::kOk;
+    // The writer is inside the latest slot, perhaps preempted there. The ring
+    // slot of latest_seq is complete: the writer stores latest_seq (release)
+    // only after writing it, and reuses it only 64 publishes later.
+    const uint64_t s = r.latest_seq();
+    if (r.seg->ring[(s - 1) % shm::kRingLength].try_load(out) && out->seq == s) {
+      return ReadResult::kOk;
+    }
+    cpu_relax();
+  }
+  return ReadResult::kBusy;
 }
 
 ReadResult ShmPoseReader::read_status(StatusRecord* out) const {

@@ -1,0 +1,26 @@
+#!/usr/bin/env bash
+# Installs the client component into a scratch prefix, builds the example
+# controller from there with pkg-config only, and runs it against a missing
+# segment (it must report "no daemon", exit 3).
+set -euo pipefail
+build_dir=$1
+source_file=$2
+prefix=$(mktemp -d)
+trap 'rm -rf "$prefix"' EXIT
+cmake --install "$build_dir" --prefix "$prefix" --component client >/dev/null
+pc_dir=$(dirname "$(find "$prefix" -name ceilpose-client.pc)")
+for f in include/ceilpose/pose_client.h; do
+  test -f "$prefix/$f" || { echo "missing $f in the install"; exit 1; }
+done
+test -n "$(find "$prefix" -name libceilpose_client.so.1)" ||
+  { echo "libceilpose_client.so.1 not installed"; exit 1; }
+flags=$(PKG_CONFIG_PATH=$pc_dir pkg-config --cflags --libs ceilpose-client)
+cc -std=c11 -Wall -Wextra -Werror "$source_file" $flags -o "$prefix/printer"
+libdir=$(PKG_CONFIG_PATH=$pc_dir pkg-config --variable=libdir ceilpose-client)
+set +e
+LD_LIBRARY_PATH=$libdir "$prefix/printer" --shm "/ceilpose-install-test-$$" 2>"$prefix/err"
+rc=$?
+set -e
+grep -q "ceilpose-install-test" "$prefix/err" || { cat "$prefix/err"; exit 1; }
+test "$rc" -eq 3 || { echo "expected exit 3, got $rc"; exit 1; }
+echo "ok: installed client builds with pkg-config and runs"
