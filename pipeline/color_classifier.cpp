@@ -10,7 +10,7 @@
 // colour, and only then classified with fixed HSV-style rules:
 //
 //  1. White reference. A sparse grid (every `white_sample_step_px`-th pixel
-//     of every step-th row, ≈ 1/64 of the frame) is read. Samples that are
+//     of every step-th row, ≈ 1/256 of the frame) is read. Samples that are
 //     neither dark (max < 40) nor colourful (HSV saturation > 0.35) are
 //     tile, rails or fixtures; the tile covers most of any ceiling view, so
 //     the median brightness of those samples is tile, and the mean R, G, B
@@ -103,8 +103,10 @@ void ColorClassifier::set_gains(const std::array<float, 3>& gains) {
   constexpr int kShift = 8 - kBitsPerChannel;
   for (int c = 0; c < 3; ++c) {
     const int place = (2 - c) * kBitsPerChannel;
+    // Fixed point (16 fractional bits) with rounding: 768 entries per frame.
+    const auto gain_q16 = static_cast<int64_t>(gains_[c] * 65536.0f + 0.5f);
     for (int level = 0; level < 256; ++level) {
-      const int norm = std::min(255, static_cast<int>(std::lround(level * gains_[c])));
+      const auto norm = std::min<int64_t>(255, (level * gain_q16 + 32768) >> 16);
       tables_[c][level] = static_cast<uint32_t>(norm >> kShift) << place;
     }
   }

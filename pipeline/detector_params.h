@@ -35,7 +35,7 @@ struct DetectorParams {
   // Grid step, in pixels, of the sparse sample that estimates the frame's
   // tile (white) reference. Smaller is steadier and costs more (about
   // width*height/step² pixel reads).
-  int white_sample_step_px = 8;
+  int white_sample_step_px = 16;
   // Share of the sampled pixels that must look like tile for the estimate to
   // be trusted; otherwise the previous frame's reference is kept (counted).
   float white_min_share = 0.05f;
