@@ -8,6 +8,7 @@
 #include <cerrno>
 #include <charconv>
 #include <cmath>
+#include <cstdio>
 #include <cstring>
 #include <fstream>
 #include <opencv2/core.hpp>
@@ -30,6 +31,23 @@ struct RecordingReader::Scratch {
 };
 
 namespace {
+
+// 'text' for an error message, with bytes that would not show (controls,
+// non-ASCII) as \xNN so the reader sees what is really in the file.
+std::string quoted(std::string_view text) {
+  std::string out = "'";
+  for (const char c : text) {
+    const auto u = static_cast<unsigned char>(c);
+    if (u < 0x20 || u >= 0x7f) {
+      char esc[8];
+      std::snprintf(esc, sizeof esc, "\\x%02X", static_cast<unsigned>(u));
+      out += esc;
+    } else {
+      out += c;
+    }
+  }
+  return out + "'";
+}
 
 // ---- recording.yaml -------------------------------------------------------
 
@@ -82,8 +100,8 @@ Result<RecordingCamera> parse_yaml(const std::string& path) {
   auto format = yaml_scalar<std::string>(root, "format", path, "a string");
   if (!format) return format.error();
   if (*format != fmt::kFormat) {
-    return make_error(path + ":" + std::to_string(line_of(root["format"])) + ": format '" +
-                      *format + "' is not '" + fmt::kFormat + "'");
+    return make_error(path + ":" + std::to_string(line_of(root["format"])) + ": format " +
+                      quoted(*format) + " is not '" + fmt::kFormat + "'");
   }
   auto version = yaml_scalar<int>(root, "version", path, "an integer");
   if (!version) return version.error();
@@ -320,7 +338,7 @@ Result<RecordingReader> RecordingReader::open(const std::string& dir) {
     RecordingRow row;
     row.csv_line = line_no;
     if (!parse_int64(fields[cols.index], &row.index)) {
-      return make_error(where + ": index '" + fields[cols.index] + "' is not an integer");
+      return make_error(where + ": index " + quoted(fields[cols.index]) + " is not an integer");
     }
     const int64_t expected_index = static_cast<int64_t>(r.rows_.size());
     if (row.index != expected_index) {
@@ -329,8 +347,8 @@ Result<RecordingReader> RecordingReader::open(const std::string& dir) {
                         "; indices count from 0 without gaps)");
     }
     if (!parse_int64(fields[cols.timestamp], &row.timestamp_ns)) {
-      return make_error(where + ": timestamp_ns '" + fields[cols.timestamp] +
-                        "' is not an integer");
+      return make_error(where + ": timestamp_ns " + quoted(fields[cols.timestamp]) +
+                        " is not an integer");
     }
     if (!r.rows_.empty() && row.timestamp_ns < r.rows_.back().timestamp_ns) {
       return make_error(where + ": timestamp_ns " + std::to_string(row.timestamp_ns) +
@@ -340,8 +358,8 @@ Result<RecordingReader> RecordingReader::open(const std::string& dir) {
     row.file = fields[cols.file];
     if (row.file.empty()) return make_error(where + ": empty file name");
     if (row.file.front() == '/') {
-      return make_error(where + ": file '" + row.file +
-                        "' must be relative to the recording directory");
+      return make_error(where + ": file " + quoted(row.file) +
+                        " must be relative to the recording directory");
     }
     if (r.has_ground_truth_columns_) {
       const std::string& gx = fields[cols.gt_x];
@@ -354,7 +372,8 @@ Result<RecordingReader> RecordingReader::open(const std::string& dir) {
               std::tuple{"gt_y_m", &gy, &row.ground_truth.y_m},
               std::tuple{"gt_yaw_rad", &gyaw, &row.ground_truth.yaw_rad}}) {
           if (!parse_double(*text, dst)) {
-            return make_error(where + ": " + name + " '" + *text + "' is not a finite number");
+            return make_error(where + ": " + name + " " + quoted(*text) +
+                              " is not a finite number");
           }
         }
         row.has_ground_truth = true;
