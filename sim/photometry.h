@@ -23,7 +23,8 @@ class Photometry {
   // `linear` holds width*height*3 floats (RGB, linear light, 1.0 = sensor
   // white at unit gain); it is used as scratch and left modified. Writes an
   // RGB24 frame of the same size into `out`. `rng_seed` drives the noise and
-  // the occluder's shape and place.
+  // the occluder's shape and place. Allocates nothing once sized, except
+  // inside OpenCV's JPEG codec when jpeg_quality > 0.
   void apply(const Effects& effects, uint64_t rng_seed, float* linear, Image* out);
 
  private:

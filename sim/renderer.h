@@ -6,6 +6,11 @@
 // conventions of SPEC §3 with the pipeline, and it is anti-aliased by area
 // integration so that sub-pixel accuracy can be measured.
 //
+// Colour: SPEC's printed sRGB values are decoded to linear light, pixels are
+// integrated there (area averages are only physical in linear light), and the
+// camera model (photometry.h) re-encodes sRGB; a uniform area at unit gain
+// shows exactly the printed value.
+//
 // Thread: one Renderer per thread (render() uses internal buffers).
 #include <cstdint>
 #include <vector>
