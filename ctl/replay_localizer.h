@@ -1,0 +1,124 @@
+#pragma once
+// Shared by `locate` and `evaluate`: the configuration (SPEC defaults,
+// --config, the recording's camera) and the frame loop that localizes every
+// frame of a recording in order. Header-only because ceilposectl compiles
+// only main.cpp, the registry and *_command.cpp.
+#include <unistd.h>
+
+#include <cstdio>
+#include <functional>
+#include <optional>
+#include <string>
+#include <utility>
+
+#include "config/service_config.h"
+#include "core/clock.h"
+#include "core/image.h"
+#include "ctl/command_registry.h"
+#include "pipeline/pipeline.h"
+#include "pipeline/pipeline_config.h"
+#include "pipeline/temporal_filter.h"
+#include "recording/recording_reader.h"
+
+namespace ceilpose::ctl {
+
+struct ReplayArgs {
+  std::string dir;
+  std::string config_file;
+  std::string mode_text;  // empty: the configuration's mode (SPEC default auto)
+  bool filter = false;
+};
+
+// Adds --replay, --config, --filter and --mode to a sub-command.
+inline void add_replay_options(CLI::App* cmd, ReplayArgs* args) {
+  cmd->add_option("--replay", args->dir, "Recording directory (SPEC §4)")->required();
+  cmd->add_option("--config", args->config_file,
+                  "Configuration file overriding SPEC's defaults (the camera intrinsics always "
+                  "come from the recording's recording.yaml)");
+  cmd->add_flag("--filter", args->filter,
+                "Apply the daemon's temporal filter (default: every frame solved on its own)");
+  cmd->add_option("--mode", args->mode_text, "Positioning mode: auto | axes | barycentric | lsq")
+      ->check(CLI::IsMember({"auto", "axes", "barycentric", "lsq"}));
+}
+
+struct ReplaySetup {
+  PipelineConfig config;
+  PositioningMode mode = PositioningMode::kAuto;
+  std::optional<RecordingReader> reader;
+};
+
+// Loads the configuration and opens the recording. On failure prints the
+// error (naming file and line) and returns the exit code, else kExitOk.
+inline int prepare_replay(const ReplayArgs& args, const char* command, ReplaySetup* setup) {
+  if (!args.config_file.empty()) {
+    auto loaded = load_config_file(args.config_file);
+    if (!loaded.ok()) {
+      std::fprintf(stderr, "ceilposectl %s: %s\n", command, loaded.error().message.c_str());
+      return kExitBadInput;
+    }
+    setup->config = loaded->pipeline;
+    setup->mode = loaded->positioning_mode;
+  }
+  if (!args.mode_text.empty() && !parse_positioning_mode(args.mode_text, &setup->mode)) {
+    std::fprintf(stderr, "ceilposectl %s: --mode %s: expected auto, axes, barycentric or lsq\n",
+                 command, args.mode_text.c_str());
+    return kExitUsage;
+  }
+  auto reader = RecordingReader::open(args.dir);
+  if (!reader.ok()) {
+    std::fprintf(stderr, "ceilposectl %s: %s\n", command, reader.error().message.c_str());
+    return kExitBadInput;
+  }
+  setup->config.intrinsics = reader->camera().intrinsics;
+  setup->reader.emplace(std::move(reader.value()));
+  return kExitOk;
+}
+
+// One localized frame: the row of frames.csv, the (filtered when asked)
+// estimate, the decoded marker count and the processing time.
+struct ReplayFrame {
+  size_t position = 0;
+  const RecordingRow* row = nullptr;
+  PoseEstimate estimate;
+  int markers_decoded = 0;
+  int64_t proc_ns = 0;
+};
+
+// Localizes every frame in order, as fast as possible. Returns the exit code:
+// kExitBadInput (message printed) when a frame cannot be loaded.
+inline int run_replay(const ReplayArgs& args, const char* command, const ReplaySetup& setup,
+                      const std::function<void(const ReplayFrame&)>& on_frame) {
+  const RecordingReader& reader = *setup.reader;
+  Pipeline pipeline(setup.config);
+  TemporalFilter filter(setup.config.filter);
+  auto result = std::make_unique<FrameResult>();
+  Image frame;
+  const size_t total = reader.rows().size();
+  const bool tty = ::isatty(STDERR_FILENO) == 1;
+  for (size_t i = 0; i < total; ++i) {
+    auto loaded = reader.load_frame(i, &frame);
+    if (!loaded.ok()) {
+      if (tty) std::fputc('\n', stderr);
+      std::fprintf(stderr, "ceilposectl %s: %s\n", command, loaded.error().message.c_str());
+      return kExitBadInput;
+    }
+    const RecordingRow& row = reader.rows()[i];
+    const int64_t start_ns = monotonic_ns();
+    pipeline.process(frame.view(), setup.mode, result.get());
+    ReplayFrame out;
+    out.estimate =
+        args.filter ? filter.update(result->estimate, row.timestamp_ns) : result->estimate;
+    out.proc_ns = monotonic_ns() - start_ns;
+    out.position = i;
+    out.row = &row;
+    out.markers_decoded = result->marker_count;
+    on_frame(out);
+    if (tty && (i % 25 == 0 || i + 1 == total)) {
+      std::fprintf(stderr, "\r%s: frame %zu/%zu", command, i + 1, total);
+      if (i + 1 == total) std::fputc('\n', stderr);
+    }
+  }
+  return kExitOk;
+}
+
+}  // namespace ceilpose::ctl

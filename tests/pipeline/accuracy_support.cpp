@@ -1,0 +1,60 @@
+#include "accuracy_support.h"
+
+#include <gtest/gtest.h>
+
+#include <cstdlib>
+#include <memory>
+
+#include "pipeline/pipeline.h"
+#include "pipeline/temporal_filter.h"
+#include "sim/renderer.h"
+#include "sim/scenarios.h"
+#include "sim/visibility.h"
+
+#if defined(__SANITIZE_ADDRESS__) || defined(__SANITIZE_THREAD__)
+#define CEILPOSE_SANITIZED 1
+#elif defined(__has_feature)
+#if __has_feature(address_sanitizer) || __has_feature(thread_sanitizer)
+#define CEILPOSE_SANITIZED 1
+#endif
+#endif
+
+namespace ceilpose::testing {
+
+int accuracy_frames(int release_frames) {
+  if (const char* env = std::getenv("CEILPOSE_ACCURACY_FRAMES")) {
+    const int n = std::atoi(env);
+    if (n > 0) return n;
+  }
+#ifdef CEILPOSE_SANITIZED
+  return std::max(20, release_frames / 5);
+#else
+  return release_frames;
+#endif
+}
+
+AccuracyReport run_scenario(const std::string& name, int frames, uint64_t seed,
+                            PositioningMode mode, bool filter, const PipelineConfig& config) {
+  sim::SceneOptions options{config.layout, config.intrinsics, seed};
+  auto scenario = sim::make_scenario(name, options, frames, seed);
+  if (!scenario.ok()) {
+    ADD_FAILURE() << scenario.error().message;
+    return {};
+  }
+  sim::Renderer renderer(options);
+  Pipeline pipeline(config);
+  TemporalFilter temporal(config.filter);
+  auto result = std::make_unique<FrameResult>();
+  AccuracyAccumulator acc(config.layout.grid_m);
+  Image image;
+  for (const sim::ScenarioFrame& f : scenario->frames) {
+    renderer.render(f.pose, f.mount, f.effects, f.seed, &image);
+    pipeline.process(image.view(), mode, result.get());
+    const PoseEstimate estimate =
+        filter ? temporal.update(result->estimate, f.timestamp_ns) : result->estimate;
+    acc.add(f.pose, sim::count_whole_markers(options, f.pose, f.mount) > 0, estimate);
+  }
+  return acc.report();
+}
+
+}  // namespace ceilpose::testing

@@ -1,0 +1,213 @@
+// `ceilposectl locate` and `ceilposectl evaluate` end to end on a small
+// rendered recording: the JSON Lines of SPEC §5, and the exit codes.
+#include <gtest/gtest.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <cmath>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "recording/recording_writer.h"
+#include "sim/renderer.h"
+
+namespace ceilpose {
+namespace {
+
+namespace fs = std::filesystem;
+
+// The binary sits at <build>/ctl/ceilposectl, this test at
+// <build>/tests/pipeline/pipeline_tests; CEILPOSECTL overrides.
+fs::path ctl_binary() {
+  if (const char* env = std::getenv("CEILPOSECTL")) return env;
+  return fs::read_symlink("/proc/self/exe").parent_path().parent_path().parent_path() / "ctl" /
+         "ceilposectl";
+}
+
+struct CommandRun {
+  int exit_code = -1;
+  std::string out;
+  std::string err;
+};
+
+class LocateCommand : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    if (!fs::exists(ctl_binary())) GTEST_SKIP() << ctl_binary() << " not built";
+    char tmpl[] = "/tmp/ceilpose_locate_XXXXXX";
+    ASSERT_NE(::mkdtemp(tmpl), nullptr);
+    dir_ = tmpl;
+  }
+  void TearDown() override {
+    if (!dir_.empty()) fs::remove_all(dir_);
+  }
+
+  CommandRun run(const std::string& args) {
+    const fs::path out = dir_ / "stdout.txt", err = dir_ / "stderr.txt";
+    const std::string cmd = ctl_binary().string() + " " + args + " >" + out.string() + " 2>" +
+                            err.string() + " </dev/null";
+    const int status = std::system(cmd.c_str());
+    CommandRun r;
+    r.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+    r.out = slurp(out);
+    r.err = slurp(err);
+    return r;
+  }
+  static std::string slurp(const fs::path& p) {
+    std::ifstream in(p);
+    std::stringstream s;
+    s << in.rdbuf();
+    return s.str();
+  }
+
+  // Renders the poses into a recording with ground truth.
+  fs::path record(const std::vector<Pose2D>& poses) {
+    const fs::path rec = dir_ / "rec";
+    sim::SceneOptions options;
+    sim::Renderer renderer(options);
+    auto writer =
+        RecordingWriter::create(rec.string(), RecordingCamera{options.intrinsics, "test"});
+    EXPECT_TRUE(writer.ok()) << writer.error().message;
+    Image image;
+    for (size_t k = 0; k < poses.size(); ++k) {
+      sim::Effects effects;
+      effects.read_noise_sigma = 2.0;
+      renderer.render(poses[k], CameraMount{}, effects, k + 1, &image);
+      auto appended =
+          writer->append(image.view(), 1'000'000'000 + 33'333'333 * int64_t(k), &poses[k]);
+      EXPECT_TRUE(appended.ok()) << appended.error().message;
+    }
+    EXPECT_TRUE(writer->close().ok());
+    return rec;
+  }
+
+  fs::path dir_;
+};
+
+std::vector<std::string> lines(const std::string& text) {
+  std::vector<std::string> out;
+  std::stringstream s(text);
+  for (std::string line; std::getline(s, line);) out.push_back(line);
+  return out;
+}
+
+// The number after "key": in a flat JSON object (NaN when absent or null).
+double field(const std::string& line, const std::string& key) {
+  const size_t at = line.find("\"" + key + "\":");
+  if (at == std::string::npos) return NAN;
+  const std::string rest = line.substr(at + key.size() + 3);
+  if (rest.rfind("null", 0) == 0) return NAN;
+  return std::strtod(rest.c_str(), nullptr);
+}
+
+TEST_F(LocateCommand, PrintsOneSpecJsonLinePerFrameWithAccuratePoses) {
+  // The last pose is far off the grid: nothing in view.
+  const std::vector<Pose2D> poses{
+      {1.2, 1.5, 0.3}, {2.0, 2.2, -2.0}, {3.0, 1.0, 1.6}, {-20.0, -20.0, 0.0}};
+  const fs::path rec = record(poses);
+  const CommandRun r = run("locate --replay " + rec.string());
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const auto out = lines(r.out);
+  ASSERT_EQ(out.size(), poses.size());
+  for (size_t k = 0; k + 1 < poses.size(); ++k) {
+    const std::string& l = out[k];
+    EXPECT_EQ(field(l, "index"), static_cast<double>(k));
+    EXPECT_EQ(field(l, "timestamp_ns"), 1e9 + 33'333'333.0 * k);
+    EXPECT_NE(l.find("\"valid\":true"), std::string::npos) << l;
+    EXPECT_NEAR(field(l, "x_m"), poses[k].x_m, 0.005) << l;
+    EXPECT_NEAR(field(l, "y_m"), poses[k].y_m, 0.005) << l;
+    EXPECT_NEAR(field(l, "yaw_rad"), poses[k].yaw_rad, 0.01) << l;
+    EXPECT_NE(l.find("\"mode\":\"lsq\""), std::string::npos) << l;
+    EXPECT_GE(field(l, "markers"), 3.0) << l;
+    EXPECT_GE(field(l, "proc_us"), 0.0) << l;
+  }
+  const std::string& off = out.back();
+  EXPECT_NE(off.find("\"valid\":false,\"x_m\":null,\"y_m\":null,\"yaw_rad\":null"),
+            std::string::npos)
+      << off;
+  EXPECT_TRUE(r.err.empty()) << "stderr is not a terminal: no progress expected: " << r.err;
+}
+
+TEST_F(LocateCommand, ForcedModeIsReportedAndFilterKeepsEveryFrame) {
+  const fs::path rec = record({{1.2, 1.5, 0.3}, {1.21, 1.5, 0.3}, {1.22, 1.5, 0.3}});
+  CommandRun r = run("locate --mode axes --replay " + rec.string());
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  for (const auto& l : lines(r.out)) EXPECT_NE(l.find("\"mode\":\"axes\""), std::string::npos);
+  r = run("locate --filter --replay " + rec.string());
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const auto out = lines(r.out);
+  ASSERT_EQ(out.size(), 3u);
+  EXPECT_NEAR(field(out[2], "x_m"), 1.22, 0.01);
+}
+
+TEST_F(LocateCommand, MalformedRecordingExitsFourNamingFileAndLine) {
+  const fs::path rec = record({{1.2, 1.5, 0.3}, {2.0, 2.2, -2.0}});
+  {
+    std::ofstream csv(rec / "frames.csv", std::ios::app);
+    csv << "2,banana,frames/000002.png,1,1,0\n";
+  }
+  const CommandRun r = run("locate --replay " + rec.string());
+  EXPECT_EQ(r.exit_code, 4);
+  EXPECT_NE(r.err.find("frames.csv"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find('4'), std::string::npos) << "line 4 named: " << r.err;
+  EXPECT_TRUE(r.out.empty());
+}
+
+TEST_F(LocateCommand, MissingRecordingExitsFour) {
+  const CommandRun r = run("locate --replay " + (dir_ / "nothing").string());
+  EXPECT_EQ(r.exit_code, 4);
+  EXPECT_NE(r.err.find("nothing"), std::string::npos) << r.err;
+}
+
+TEST_F(LocateCommand, UnknownModeIsAUsageError) {
+  const CommandRun r = run("locate --mode fancy --replay " + dir_.string());
+  EXPECT_EQ(r.exit_code, 2);
+}
+
+TEST_F(LocateCommand, MissingReplayIsAUsageError) {
+  const CommandRun r = run("locate");
+  EXPECT_EQ(r.exit_code, 2);
+}
+
+TEST_F(LocateCommand, UnreadableConfigExitsFourNamingTheFile) {
+  const fs::path rec = record({{1.2, 1.5, 0.3}});
+  const CommandRun r =
+      run("locate --config " + (dir_ / "absent.yaml").string() + " --replay " + rec.string());
+  EXPECT_EQ(r.exit_code, 4);
+  EXPECT_NE(r.err.find("absent.yaml"), std::string::npos) << r.err;
+}
+
+TEST_F(LocateCommand, ConfigFileOverridesDefaults) {
+  const fs::path rec = record({{1.2, 1.5, 0.3}});
+  // A mount offset moves the reported robot pose by that offset.
+  {
+    std::ofstream yaml(dir_ / "c.yaml");
+    yaml << "mount:\n  offset_forward_m: 0.1\n";
+  }
+  const CommandRun r =
+      run("locate --config " + (dir_ / "c.yaml").string() + " --replay " + rec.string());
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const auto out = lines(r.out);
+  ASSERT_EQ(out.size(), 1u);
+  EXPECT_NEAR(field(out[0], "x_m"), 1.2 - 0.1 * std::cos(0.3), 0.005) << out[0];
+  EXPECT_NEAR(field(out[0], "y_m"), 1.5 - 0.1 * std::sin(0.3), 0.005) << out[0];
+}
+
+TEST_F(LocateCommand, EvaluateScoresAgainstGroundTruth) {
+  const fs::path rec = record({{1.2, 1.5, 0.3}, {2.0, 2.2, -2.0}, {-20.0, -20.0, 0.0}});
+  const CommandRun r = run("evaluate --json --replay " + rec.string());
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_EQ(field(r.out, "frames"), 3.0) << r.out;
+  EXPECT_EQ(field(r.out, "frames_with_whole"), 2.0) << r.out;
+  EXPECT_EQ(field(r.out, "availability"), 1.0) << r.out;
+  EXPECT_EQ(field(r.out, "within_both"), 1.0) << r.out;
+  EXPECT_EQ(field(r.out, "gross"), 0.0) << r.out;
+  EXPECT_LT(field(r.out, "max_error_mm"), 5.0) << r.out;
+}
+
+}  // namespace
+}  // namespace ceilpose
