@@ -164,6 +164,7 @@ void print_json(const RecordingReader& reader, const Summary& s) {
   field("frames", std::to_string(s.frames));
   field("duration_s", fixed(s.duration_s, 6));
   field("fps", s.fps > 0.0 ? fixed(s.fps, 3) : "null");
+  field("size", "\"" + std::to_string(k.width) + "x" + std::to_string(k.height) + "\"");
   field("width", std::to_string(k.width));
   field("height", std::to_string(k.height));
   field("fx", shortest(k.fx));

@@ -30,9 +30,9 @@ TEST_F(InspectCommand, SummarisesAValidRecording) {
 TEST_F(InspectCommand, JsonSummaryHasFramesDurationFpsSizeAndGroundTruth) {
   const CommandOutput r = run_ceilposectl({"inspect", dir_, "--json"}, tmp_.path());
   EXPECT_EQ(r.exit_code, 0) << r.err;
-  expect_mentions(
-      r.out, {"\"valid\":true", "\"frames\":5", "\"duration_s\":0.066667", "\"fps\":60.000",
-              "\"width\":64", "\"height\":48", "\"has_ground_truth\":true", "\"decoded\":false"});
+  expect_mentions(r.out, {"\"valid\":true", "\"frames\":5", "\"duration_s\":0.066667",
+                          "\"fps\":60.000", "\"size\":\"64x48\"", "\"width\":64", "\"height\":48",
+                          "\"has_ground_truth\":true", "\"decoded\":false"});
 }
 
 TEST_F(InspectCommand, DecodeReportsProgressOnStderrAndDecodeTime) {

@@ -154,6 +154,20 @@ TEST_F(RecordingWriterTest, JpegFramesReadBackCloseToTheOriginal) {
   EXPECT_LT(sum_abs / static_cast<double>(image_.size_bytes()), 15.0);
 }
 
+TEST_F(RecordingWriterTest, GreyJpegFramesReadBackAsGrey) {
+  const Image original = pattern_image(64, 48, PixelFormat::kGray8, 2);
+  ASSERT_EQ(append(original.view(), 1, nullptr, 95), "");
+  ASSERT_TRUE(writer_->close().ok());
+  ASSERT_NO_FATAL_FAILURE(load(0));
+  ASSERT_EQ(image_.format(), PixelFormat::kGray8);
+  ASSERT_EQ(image_.size_bytes(), original.size_bytes());
+  double sum_abs = 0.0;
+  for (size_t i = 0; i < image_.size_bytes(); ++i) {
+    sum_abs += std::abs(int{image_.data()[i]} - int{original.data()[i]});
+  }
+  EXPECT_LT(sum_abs / static_cast<double>(image_.size_bytes()), 15.0);
+}
+
 TEST_F(RecordingWriterTest, MjpegPayloadIsStoredVerbatim) {
   const std::vector<uint8_t> jpeg = jpeg_64x48();
   ASSERT_EQ(append(mjpeg_view(jpeg, jpeg.size()), 5), "");
