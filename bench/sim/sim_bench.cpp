@@ -1,5 +1,7 @@
 // Renderer speed: one frame per iteration, one thread, for the clean scene
-// and for the combined stress effects, at three resolutions.
+// (scenario `random`), with sensor noise (`nominal`, what the synthetic
+// camera typically renders) and with every stress effect (`stress`), at three
+// resolutions.
 //   ninja -C build sim_bench && build/bench/sim/sim_bench
 #include <benchmark/benchmark.h>
 
@@ -29,9 +31,11 @@ void run(benchmark::State& state, const char* scenario_name) {
 }
 
 void BM_RenderClean(benchmark::State& state) { run(state, "random"); }
+void BM_RenderNominal(benchmark::State& state) { run(state, "nominal"); }
 void BM_RenderStress(benchmark::State& state) { run(state, "stress"); }
 
 BENCHMARK(BM_RenderClean)->Arg(320)->Arg(640)->Arg(1280)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_RenderNominal)->Arg(320)->Arg(640)->Arg(1280)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_RenderStress)->Arg(320)->Arg(640)->Arg(1280)->Unit(benchmark::kMillisecond);
 
 }  // namespace

@@ -67,6 +67,32 @@ TEST(RendererConventions, SlotsReadBackEveryCodeOfEveryMarkerInView) {
   EXPECT_GT(markers, 20);
 }
 
+TEST(RendererConventions, SlotsReadBackWithAFourBitFamily) {
+  // An extension of SPEC §2: four slots need taller rectangles (16 in).
+  SceneOptions options;
+  options.layout.bits = 4;
+  options.layout.rect_height_m = 16 * kInch_m;
+  Renderer renderer(options);
+  const double g = options.layout.grid_m;
+  std::set<int> seen_i, seen_j;
+  for (int k = 0; k < 16; k += 3) {
+    const Pose2D robot{(k + 0.3) * g, (15 - k + 0.2) * g, 0.25 * k};
+    Image img;
+    renderer.render(robot, CameraMount{}, Effects{}, 1, &img);
+    const CameraPose camera = camera_pose_from_robot(robot, CameraMount{});
+    for (int i = 0; i < 16; ++i)
+      for (int j = 0; j < 16; ++j) {
+        if (!marker_whole_in_view(options, camera, i, j)) continue;
+        EXPECT_EQ(read_code(img, options, camera, i, j, options.layout.red_centre_e_m()), i);
+        EXPECT_EQ(read_code(img, options, camera, i, j, options.layout.green_centre_e_m()), j);
+        seen_i.insert(i);
+        seen_j.insert(j);
+      }
+  }
+  EXPECT_GE(seen_i.size(), 12u);
+  EXPECT_GE(seen_j.size(), 12u);
+}
+
 struct Centroids {
   double red_u = 0, red_v = 0, green_u = 0, green_v = 0;
 };
