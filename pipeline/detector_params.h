@@ -90,6 +90,14 @@ struct DetectorParams {
   // unset and give a valid-looking wrong code. Lower it to trade wrong
   // codes for availability.
   float dot_min_margin = 0.1f;
+  // A marker is not decoded when the blur along North (edge_spread_px at
+  // the red rectangle's ends, 25–75 % rise) exceeds this fraction of the red
+  // dot's height in pixels: such blur can wash a 1 in dot out completely,
+  // and an unset slot then looks confidently unset. 0.5 px sharp edges pass
+  // at any size; at 640×480 (6.3 px dots) a spread up to ≈ 2.8 px passes
+  // (issue 3 stress: 99.4 % of whole markers kept); at 320×240 the same
+  // blur is refused instead of misread.
+  float max_blur_to_dot = 0.45f;
 };
 
 }  // namespace ceilpose

@@ -40,6 +40,15 @@ struct CodeReading {
 CodeReading read_code(const ImageView& frame, const MarkerFrame& marker, bool red,
                       const CeilingLayout& layout, const DetectorParams& params);
 
+// Blur along North at the rectangle's two short ends, in pixels: the
+// distance over which the darkest channel climbs from 25 % to 75 % of the
+// way from the rectangle's level to the tile's (0.5 px for a sharp edge;
+// 1.35 σ for Gaussian blur; half the length of motion blur along North).
+// Negative when it cannot be measured (an end outside the frame, too little
+// contrast). Sparse reads, no allocation.
+double edge_spread_px(const ImageView& frame, const MarkerFrame& marker, bool red,
+                      const CeilingLayout& layout);
+
 // Whether the dark pixels found inside a rectangle fit the dots its code
 // says it has: more dark area than the dots plus slack means dirt, an
 // occluder or a foreign pattern, not a marker.

@@ -89,6 +89,11 @@ bool Pipeline::decode(const ImageView& frame, const MarkerPair& pair, MarkerObse
     ++counters_.unreadable_codes;
     return false;
   }
+  const double red_dot_px = layout.red_dot_n_m * std::hypot(m.north_u, m.north_v);
+  if (edge_spread_px(frame, m, true, layout) > config_.detector.max_blur_to_dot * red_dot_px) {
+    ++counters_.blurred_markers;
+    return false;
+  }
   if (std::min(code_i.margin, code_j.margin) < config_.detector.dot_min_margin) {
     ++counters_.ambiguous_codes;
     return false;

@@ -46,6 +46,7 @@ struct PipelineCounters {
   uint64_t cut_markers = 0;           // pairs touching the frame border, not decoded
   uint64_t unreadable_codes = 0;      // pairs whose slots fell outside the frame
   uint64_t ambiguous_codes = 0;       // a slot too close to the dot threshold
+  uint64_t blurred_markers = 0;       // blur along North too wide for the red dots
   uint64_t inconsistent_markers = 0;  // dark area disagreeing with the code
   uint64_t marker_overflow = 0;       // frames with more than kMaxMarkersPerFrame
 };

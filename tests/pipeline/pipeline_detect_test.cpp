@@ -192,6 +192,37 @@ TEST_F(PipelineDetectTest, BadFramesGiveAnInvalidPoseWithoutCrashing) {
   EXPECT_GE(pipeline.counters().run_budget_exceeded, 1u);
 }
 
+TEST_F(PipelineDetectTest, MarkerBlurredBeyondItsRedDotsIsRefusedNotMisread) {
+  // Half-size markers (3 px red dots) under 5 px of blur along North: the
+  // red dots wash out, so the marker must not be decoded at all.
+  PipelineConfig small = config;
+  small.intrinsics = {320, 240, 265.0, 265.0, 159.5, 119.5, {}};
+  Pipeline half(small);
+  test::CraftedMarker m;
+  m.centre_u_px = 160.3;
+  m.centre_v_px = 120.2;
+  m.code_i = 7;
+  m.code_j = 7;
+  const Image sharp = test::render_markers(320, 240, std::span(&m, 1), config.layout, {},
+                                           0.5 * test::kDefaultPxPerM);
+  half.process(sharp.view(), PositioningMode::kAuto, &result);
+  ASSERT_EQ(result.marker_count, 1);
+  Image blurred = sharp;
+  for (int y = 0; y < 240; ++y) {
+    for (int x = 0; x < 320; ++x) {
+      for (int c = 0; c < 3; ++c) {
+        int sum = 0;
+        for (int k = -2; k <= 2; ++k)
+          sum += sharp.data()[y * 960 + 3 * std::clamp(x + k, 0, 319) + c];
+        blurred.row(y)[3 * x + c] = static_cast<uint8_t>(sum / 5);
+      }
+    }
+  }
+  half.process(blurred.view(), PositioningMode::kAuto, &result);
+  EXPECT_EQ(result.marker_count, 0);
+  EXPECT_EQ(half.counters().blurred_markers, 1u);
+}
+
 TEST_F(PipelineDetectTest, ProcessAllocatesNothing) {
   const Image image = test::render_markers(640, 480, four_markers(0.7), config.layout);
   pipeline.process(image.view(), PositioningMode::kAuto, &result);  // warm-up
