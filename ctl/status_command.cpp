@@ -30,6 +30,14 @@ struct Snapshot {
   int64_t now_ns = 0;
 };
 
+// How long the daemon has run: until now, or until it marked itself stopped
+// (its last heartbeat).
+int64_t run_ns(const Snapshot& s) {
+  const int64_t end_ns =
+      s.info.state == WriterState::kStopped ? s.info.heartbeat_mono_ns : s.now_ns;
+  return end_ns - s.info.start_mono_ns;
+}
+
 std::string age_ms_json(bool known, int64_t now_ns, int64_t then_ns) {
   return known ? fixed_text(static_cast<double>(now_ns - then_ns) / 1e6, 1) : "null";
 }
@@ -42,7 +50,7 @@ void print_json(const StatusArgs& args, const Snapshot& s) {
       ",\"live\":" + (s.liveness == Liveness::kLive ? "true" : "false") +
       ",\"pid\":" + std::to_string(s.info.pid) +
       ",\"generation\":" + std::to_string(s.info.generation) +
-      ",\"uptime_s\":" + fixed_text(static_cast<double>(s.now_ns - s.info.start_mono_ns) / 1e9, 3) +
+      ",\"uptime_s\":" + fixed_text(static_cast<double>(run_ns(s)) / 1e9, 3) +
       ",\"start_real_ns\":" + std::to_string(s.info.start_real_ns) +
       ",\"heartbeat_age_ms\":" + age_ms_json(true, s.now_ns, s.info.heartbeat_mono_ns);
   if (s.has_status) {
@@ -68,9 +76,15 @@ void print_json(const StatusArgs& args, const Snapshot& s) {
 
 void print_human(const StatusArgs& args, const Snapshot& s) {
   const StatusRecord& st = s.status;
-  std::printf("ceilposed on %s: %s (%s), pid %d, up %s\n", args.shm.c_str(),
-              to_string(s.info.state), to_string(s.liveness), s.info.pid,
-              duration_text(s.now_ns - s.info.start_mono_ns).c_str());
+  if (s.info.state == WriterState::kStopped) {
+    std::printf("ceilposed on %s: stopped %s ago after running %s, pid %d\n", args.shm.c_str(),
+                duration_text(s.now_ns - s.info.heartbeat_mono_ns).c_str(),
+                duration_text(run_ns(s)).c_str(), s.info.pid);
+  } else {
+    std::printf("ceilposed on %s: %s (%s), pid %d, up %s\n", args.shm.c_str(),
+                to_string(s.info.state), to_string(s.liveness), s.info.pid,
+                duration_text(run_ns(s)).c_str());
+  }
   if (s.has_status) {
     std::printf("  source     %s\n", st.source[0] != '\0' ? st.source : "(not reported)");
     std::printf("  fix        %s\n", to_string(static_cast<FixState>(st.fix_state)));

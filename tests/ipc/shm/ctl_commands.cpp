@@ -147,6 +147,15 @@ TEST_F(CtlCommands, StatusHumanOutputNamesSourceAndLatency) {
   EXPECT_TRUE(contains(out_, "p99 7.30 ms")) << out_;
 }
 
+TEST_F(CtlCommands, StatusSaysStoppedAndExitsNoDaemonAfterCleanStop) {
+  ASSERT_NO_FATAL_FAILURE(start());
+  writer().publish(sample_pose(1));
+  writer().mark_stopped();
+  EXPECT_EQ(run({"status", "--shm", name()}), kExitNoDaemon);
+  EXPECT_TRUE(contains(out_, "stopped")) << out_;
+  EXPECT_TRUE(contains(err_, "stopped")) << err_;
+}
+
 TEST_F(CtlCommands, StatusExitsNoDaemonWhenSegmentIsMissing) {
   EXPECT_EQ(run({"status", "--shm", name()}), kExitNoDaemon);
   EXPECT_TRUE(contains(err_, name())) << err_;
