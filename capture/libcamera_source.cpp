@@ -44,12 +44,21 @@ LibcameraSource::LibcameraSource(std::string camera_id, SourceOptions options)
 
 LibcameraSource::~LibcameraSource() {
   do_stop();
+  close_camera();
+}
+
+// Releases everything open() and start() took, so that a failed open() can be
+// retried: libcamera allows only one CameraManager per process at a time.
+void LibcameraSource::close_camera() {
   unmap_all();
   requests_.clear();
   allocator_.reset();
   if (acquired_) camera_->release();
+  acquired_ = false;
   camera_.reset();
   if (manager_) manager_->stop();
+  manager_.reset();
+  stream_ = nullptr;
 }
 
 std::string LibcameraSource::describe() const {
@@ -60,17 +69,21 @@ std::string LibcameraSource::describe() const {
 }
 
 Result<void> LibcameraSource::do_open() {
+  Result<void> r = open_camera();
+  if (!r) close_camera();
+  return r;
+}
+
+Result<void> LibcameraSource::open_camera() {
   const std::string name = camera_id_.empty() ? "libcamera" : "libcamera:" + camera_id_;
   manager_ = std::make_unique<lc::CameraManager>();
   if (const int r = manager_->start(); r < 0) {
-    manager_.reset();
+    manager_.reset();  // never started, so not to be stopped
     return make_error(name +
                       ": Failed to start the libcamera camera manager: " + std::strerror(-r));
   }
   const auto cameras = manager_->cameras();
   if (cameras.empty()) {
-    manager_->stop();
-    manager_.reset();
     return make_error(name +
                       ": no camera found (libcamera lists 0 cameras; is one connected "
                       "and supported by a libcamera pipeline handler?)");
@@ -82,8 +95,6 @@ Result<void> LibcameraSource::do_open() {
     if (!camera_) {
       std::string ids;
       for (const auto& c : cameras) ids += (ids.empty() ? "" : ", ") + c->id();
-      manager_->stop();
-      manager_.reset();
       return make_error(name + ": no camera with this id; libcamera has: " + ids);
     }
   }

@@ -54,6 +54,8 @@ class LibcameraSource final : public FrameSource {
     size_t length = 0;
     size_t offset = 0;  // of plane 0 inside the mapping
   };
+  Result<void> open_camera();
+  void close_camera();
   void on_request_completed(libcamera::Request* request);
   void unmap_all();
 
