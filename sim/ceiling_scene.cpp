@@ -129,10 +129,10 @@ CeilingScene::CeilingScene(const CeilingLayout& layout, uint64_t seed)
   fixture_tiles_.assign(static_cast<size_t>(fixture_tiles_side_) * fixture_tiles_side_, 0);
   for (int tj = 0; tj < fixture_tiles_side_; ++tj)
     for (int ti = 0; ti < fixture_tiles_side_; ++ti) {
-      double he = 0.0, hn = 0.0;
-      if (fixture_on_tile(ti - kFixtureTableMargin, tj - kFixtureTableMargin, &he, &hn))
+      double half_e_m = 0.0, half_n_m = 0.0;
+      if (fixture_on_tile(ti - kFixtureTableMargin, tj - kFixtureTableMargin, &half_e_m, &half_n_m))
         fixture_tiles_[static_cast<size_t>(tj) * fixture_tiles_side_ + ti] =
-            he < hn ? kFixtureNorthSouth : kFixtureEastWest;
+            half_e_m < half_n_m ? kFixtureNorthSouth : kFixtureEastWest;
     }
 }
 

@@ -97,9 +97,9 @@ inline uint8_t CeilingScene::fixture_kind(int64_t ti, int64_t tj) const {
   const int64_t a = ti + kFixtureTableMargin, b = tj + kFixtureTableMargin;
   if (a >= 0 && b >= 0 && a < fixture_tiles_side_ && b < fixture_tiles_side_)
     return fixture_tiles_[static_cast<size_t>(b) * fixture_tiles_side_ + static_cast<size_t>(a)];
-  double he = 0.0, hn = 0.0;
-  if (!fixture_on_tile(ti, tj, &he, &hn)) return kNoFixture;
-  return he < hn ? kFixtureNorthSouth : kFixtureEastWest;
+  double half_e_m = 0.0, half_n_m = 0.0;
+  if (!fixture_on_tile(ti, tj, &half_e_m, &half_n_m)) return kNoFixture;
+  return half_e_m < half_n_m ? kFixtureNorthSouth : kFixtureEastWest;
 }
 
 inline uint8_t CeilingScene::marker_material(int i, int j, double e_m, double n_m) const {
