@@ -15,7 +15,7 @@ done
 test -n "$(find "$prefix" -name libceilpose_client.so.1)" ||
   { echo "libceilpose_client.so.1 not installed"; exit 1; }
 flags=$(PKG_CONFIG_PATH=$pc_dir pkg-config --cflags --libs ceilpose-client)
-cc -std=c11 -Wall -Wextra -Werror "$source_file" $flags -o "$prefix/printer"
+cc -std=c11 -Wall -Wextra -Wpedantic -Werror "$source_file" $flags -o "$prefix/printer"
 libdir=$(PKG_CONFIG_PATH=$pc_dir pkg-config --variable=libdir ceilpose-client)
 set +e
 LD_LIBRARY_PATH=$libdir "$prefix/printer" --shm "/ceilpose-install-test-$$" 2>"$prefix/err"
