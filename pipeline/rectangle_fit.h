@@ -31,6 +31,11 @@ struct RectangleModel {
   double expected_area_px = 0.0;
   double expected_long_px = 0.0;
   double expected_short_px = 0.0;
+  // With lens distortion, shape tests run on the blob's moments mapped back
+  // to the undistorted image, and centroids are corrected for the shift
+  // that distortion's curvature gives an area centroid.
+  CameraIntrinsics intrinsics;
+  bool distorted = false;
 };
 
 // Scale at the image centre for a level camera: f / (H − h).
