@@ -7,6 +7,7 @@
 #include <new>
 
 #include "sim/renderer.h"
+#include "tests/sim/sim_test_support.h"
 
 namespace {
 
@@ -33,17 +34,8 @@ namespace ceilpose::sim {
 namespace {
 
 TEST(RendererAllocation, SecondFrameWithEveryNonJpegEffectAllocatesNothing) {
-  Effects e;
-  e.gain = 1.2;
-  e.gradient_amplitude = 0.3;
-  e.white_balance = {1.1, 1.0, 0.9};
-  e.read_noise_sigma = 4.0;
-  e.shot_noise_scale = 0.2;
-  e.defocus_sigma_px = 1.5;
-  e.motion_blur_px = 5.0;
-  e.bloom = 0.3;
-  e.occlusion_fraction = 0.1;
-  e.clutter_objects = 10;
+  // JPEG is left out: OpenCV's codec allocates internally.
+  const Effects e = testing::every_effect(0);
   SceneOptions options;
   Renderer renderer(options);
   Image img;

@@ -6,25 +6,12 @@
 
 #include "sim/renderer.h"
 #include "sim/scenarios.h"
+#include "tests/sim/sim_test_support.h"
 
 namespace ceilpose::sim {
 namespace {
 
-Effects everything() {
-  Effects e;
-  e.gain = 1.3;
-  e.gradient_amplitude = 0.2;
-  e.white_balance = {1.1, 0.95, 0.8};
-  e.read_noise_sigma = 5.0;
-  e.shot_noise_scale = 0.3;
-  e.defocus_sigma_px = 1.0;
-  e.motion_blur_px = 3.0;
-  e.jpeg_quality = 70;
-  e.bloom = 0.5;
-  e.occlusion_fraction = 0.1;
-  e.clutter_objects = 8;
-  return e;
-}
+Effects everything() { return testing::every_effect(70); }
 
 bool same_pixels(const Image& a, const Image& b) {
   return a.size_bytes() == b.size_bytes() && std::memcmp(a.data(), b.data(), a.size_bytes()) == 0;

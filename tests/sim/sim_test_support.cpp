@@ -8,6 +8,22 @@
 
 namespace ceilpose::sim::testing {
 
+Effects every_effect(int jpeg_quality) {
+  Effects e;
+  e.gain = 1.3;
+  e.gradient_amplitude = 0.2;
+  e.white_balance = {1.1, 0.95, 0.8};
+  e.read_noise_sigma = 5.0;
+  e.shot_noise_scale = 0.3;
+  e.defocus_sigma_px = 1.0;
+  e.motion_blur_px = 3.0;
+  e.jpeg_quality = jpeg_quality;
+  e.bloom = 0.5;
+  e.occlusion_fraction = 0.1;
+  e.clutter_objects = 8;
+  return e;
+}
+
 Point2 projected_polygon_centroid(const CameraIntrinsics& k, const CameraPose& camera,
                                   const std::vector<Vec3>& corners_w) {
   constexpr int kPerEdge = 400;

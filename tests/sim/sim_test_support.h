@@ -7,8 +7,13 @@
 #include "core/camera_model.h"
 #include "core/ceiling_layout.h"
 #include "core/image.h"
+#include "sim/effects.h"
 
 namespace ceilpose::sim::testing {
+
+// Every effect switched on at a moderate level; `jpeg_quality` 0 leaves the
+// JPEG round trip out.
+Effects every_effect(int jpeg_quality);
 
 struct Point2 {
   double u = 0.0, v = 0.0;
