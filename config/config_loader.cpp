@@ -280,6 +280,13 @@ void check_cross_keys(Reader& r, const ServiceConfig& c) {
             "expected at least capture.reconnect_initial_ms = " +
                 std::to_string(c.capture.reconnect_initial_ms) + ", found " +
                 std::to_string(c.capture.reconnect_max_ms));
+  r.require(
+      c.capture.pipeline_rt_priority == 0 || c.capture.rt_priority == 0 ||
+          c.capture.pipeline_rt_priority < c.capture.rt_priority,
+      "capture.pipeline_rt_priority",
+      "expected a priority below capture.rt_priority = " + std::to_string(c.capture.rt_priority) +
+          " (the capture thread must preempt it), found " +
+          std::to_string(c.capture.pipeline_rt_priority));
   const double marker_n_m = (p.layout.bits - 1) * p.layout.slot_pitch_m;
   r.require(marker_n_m < p.layout.rect_height_m, "ceiling.slot_pitch_m",
             "expected all " + std::to_string(p.layout.bits) +

@@ -118,8 +118,12 @@ void describe(V& v, ServiceConfig& c) {
     v.field("fill_max", d.fill_max, 0.0f, 2.0f);
     v.field("pair_distance_tolerance", d.pair_distance_tolerance, 0.0f, 10.0f);
     v.field("pair_area_tolerance", d.pair_area_tolerance, 0.0f, 10.0f);
+    v.field("pair_length_tolerance", d.pair_length_tolerance, 0.0f, 10.0f);
     v.field("pair_angle_tolerance_rad", d.pair_angle_tolerance_rad, 0.0f, 3.15f);
     v.field("dot_threshold_ratio", d.dot_threshold_ratio, 0.0f, 1.0f);
+    v.field("dot_search_m", d.dot_search_m, 0.0, 1.0);
+    v.field("dot_min_margin", d.dot_min_margin, 0.0f, 1.0f);
+    v.field("max_blur_to_dot", d.max_blur_to_dot, 0.0f, 100.0f);
   });
   v.section("positioning", [&] {
     v.choice("mode", c.positioning_mode,
@@ -178,6 +182,7 @@ void describe(V& v, ServiceConfig& c) {
     v.field("buffer_count", k.buffer_count, 2, 32);
     v.field("rt_priority", k.rt_priority, 0, 99);
     v.field("cpu", k.cpu, -1, 1023);
+    v.field("pipeline_rt_priority", k.pipeline_rt_priority, 0, 99);
     v.field("lock_exposure", k.lock_exposure);
     v.field("exposure_us", k.exposure_us, 1, 10'000'000);
     v.field("lock_gain", k.lock_gain);

@@ -25,6 +25,10 @@ struct CaptureConfig {
   int buffer_count = 4;               // driver buffers (V4L2 mmap) and ring slots
   int rt_priority = 50;               // SCHED_FIFO priority of the capture thread; 0 = normal
   int cpu = -1;                       // CPU the capture thread is pinned to; -1 = any
+  // SCHED_FIFO priority of the pipeline thread: below the capture thread's so
+  // that a frame is never lost to localization, above ordinary load so that a
+  // busy machine does not delay the pose. 0 = normal scheduling.
+  int pipeline_rt_priority = 40;
   // Auto exposure, gain and white balance ruin colour thresholds (the thesis's
   // main failure), so a camera's are locked by default.
   bool lock_exposure = true;

@@ -1,6 +1,7 @@
 #include "daemon/pipeline_worker.h"
 
 #include <pthread.h>
+#include <sched.h>
 
 #include <chrono>
 #include <cmath>
@@ -39,6 +40,14 @@ PipelineWorker::~PipelineWorker() { stop(); }
 void PipelineWorker::start() {
   thread_ = std::thread([this] { run(); });
   pthread_setname_np(thread_.native_handle(), "ceilpose-pipe");
+  if (options_.rt_priority > 0) {
+    // From here rather than the thread itself so that the result is known
+    // (and logged by the caller) before the first frame.
+    sched_param param{};
+    param.sched_priority = options_.rt_priority;
+    realtime_.store(pthread_setschedparam(thread_.native_handle(), SCHED_FIFO, &param) == 0,
+                    std::memory_order_release);
+  }
 }
 
 void PipelineWorker::stop() {

@@ -50,6 +50,7 @@ struct PoseSnapshot {
 
 struct WorkerOptions {
   int status_interval_ms = 1000;
+  int rt_priority = 0;  // SCHED_FIFO priority of the thread; 0 = normal scheduling
   // Test hook (CEILPOSE_TEST_STALL_AFTER_FRAMES, docs/service.md): after this
   // many frames the thread stops making progress until stop(), as a hung
   // pipeline would. 0 = never.
@@ -78,6 +79,8 @@ class PipelineWorker {
   PoseSnapshot latest() const;
   const capture::FrameLatency& latency() const { return latency_; }
   uint64_t frames() const { return frames_.load(std::memory_order_relaxed); }
+  // Whether the thread got SCHED_FIFO (valid after start()).
+  bool realtime() const { return realtime_.load(std::memory_order_acquire); }
 
  private:
   struct Pending {
@@ -117,6 +120,7 @@ class PipelineWorker {
   std::atomic<uint64_t> frames_{0};
   std::atomic<bool> stop_{false};
   std::atomic<bool> finished_{false};
+  std::atomic<bool> realtime_{false};
   std::thread thread_;
 
   mutable std::mutex snapshot_mutex_;  // writer only try_locks: never waits

@@ -229,11 +229,19 @@ int Service::start() {
   WorkerOptions wopts;
   wopts.status_interval_ms = config_.watchdog.status_interval_ms;
   wopts.stall_after_frames = stall_after_frames_from_env();
+  wopts.rt_priority = config_.capture.pipeline_rt_priority;
   worker_ = std::make_unique<PipelineWorker>(config_, wopts, capture_.get(), &*shm_, dds,
                                              &problems_, &progress_);
   worker_->start();
-  spdlog::info("ceilposed running: shared memory {}, positioning {}, filter {}", shm_->name(),
-               to_string(config_.positioning_mode), config_.pipeline.filter.enabled ? "on" : "off");
+  if (wopts.rt_priority > 0 && !worker_->realtime())
+    spdlog::warn(
+        "pipeline thread: SCHED_FIFO {} not permitted (needs LimitRTPRIO or "
+        "CAP_SYS_NICE); running at normal priority",
+        wopts.rt_priority);
+  spdlog::info("ceilposed running: shared memory {}, positioning {}, filter {}{}", shm_->name(),
+               to_string(config_.positioning_mode), config_.pipeline.filter.enabled ? "on" : "off",
+               worker_->realtime() ? ", pipeline SCHED_FIFO " + std::to_string(wopts.rt_priority)
+                                   : std::string());
   notifier_.ready("running, waiting for the first frame");
   return kExitOk;
 }

@@ -1,0 +1,204 @@
+// End-to-end latency of ceilposed's frame path, frame ready (dequeued by the
+// capture thread) to pose published on shared memory, using the daemon's own
+// PipelineWorker: synthetic and replay sources at 30, 60 and 120 fps, 640x480,
+// with the other core idle or busy (a spinning thread pinned to it).
+//
+// Each case runs for --duration_s seconds (default 2) of wall time; the figures
+// are counters: p50/p99/max in microseconds, frames, and the frames skipped or
+// dropped to stay current ("backlog": the pipeline never works through a queue,
+// so a pipeline slower than the camera shows up here, not as growing latency).
+//   latency_bench                                   # all cases, 2 s each
+//   latency_bench --duration_s=300 --benchmark_filter='synthetic/fps:60/load:0'
+#include <benchmark/benchmark.h>
+#include <pthread.h>
+#include <sched.h>
+#include <spdlog/spdlog.h>
+#include <unistd.h>
+
+#include <atomic>
+#include <chrono>
+#include <cstdlib>
+#include <cstring>
+#include <filesystem>
+#include <string>
+#include <thread>
+
+#include "capture/capture_thread.h"
+#include "capture/frame_source.h"
+#include "config/service_config.h"
+#include "core/clock.h"
+#include "daemon/pipeline_worker.h"
+#include "ipc/shm/shm_pose_writer.h"
+#include "recording/recording_writer.h"
+#include "sim/renderer.h"
+#include "sim/scenarios.h"
+
+namespace ceilpose {
+namespace {
+
+double g_duration_s = 2.0;
+std::string g_replay_dir;
+
+// Spins on one CPU until destroyed: "the other core loaded".
+class BusyCore {
+ public:
+  explicit BusyCore(int cpu) {
+    thread_ = std::thread([this, cpu] {
+      cpu_set_t set;
+      CPU_ZERO(&set);
+      CPU_SET(cpu, &set);
+      pthread_setaffinity_np(pthread_self(), sizeof(set), &set);
+      volatile uint64_t x = 0;
+      while (!stop_.load(std::memory_order_relaxed)) x = x + 1;
+    });
+  }
+  ~BusyCore() {
+    stop_.store(true);
+    thread_.join();
+  }
+
+ private:
+  std::atomic<bool> stop_{false};
+  std::thread thread_;
+};
+
+// A looping recording of the walking-speed trajectory, rendered once.
+std::string replay_dir() {
+  if (!g_replay_dir.empty()) return g_replay_dir;
+  const std::string dir = "/tmp/ceilpose-latency-bench-" + std::to_string(getpid());
+  std::filesystem::remove_all(dir);
+  sim::SceneOptions options;
+  auto scenario = sim::make_scenario("trajectory", options, 90, 7);
+  if (!scenario) throw std::runtime_error(scenario.error().message);
+  RecordingCamera camera;
+  camera.intrinsics = options.intrinsics;
+  camera.source = "latency_bench: sim trajectory";
+  auto writer = RecordingWriter::create(dir, camera);
+  if (!writer) throw std::runtime_error(writer.error().message);
+  sim::Renderer renderer(options);
+  Image frame;
+  for (const auto& f : scenario->frames) {
+    renderer.render(f.pose, f.mount, f.effects, f.seed, &frame);
+    if (auto ok = writer->append(frame.view(), f.timestamp_ns, &f.pose); !ok)
+      throw std::runtime_error(ok.error().message);
+  }
+  if (auto ok = writer->close(); !ok) throw std::runtime_error(ok.error().message);
+  g_replay_dir = dir;
+  return dir;
+}
+
+void BM_FrameToPose(benchmark::State& state, bool replay) {
+  const double fps = static_cast<double>(state.range(0));
+  const bool loaded = state.range(1) != 0;
+
+  ServiceConfig config = default_config();
+  config.capture.fps = fps;
+  config.capture.cpu = 0;  // capture on CPU 0; the load (if any) on CPU 1
+  config.watchdog.status_interval_ms = 1000;
+  std::string spec = "synthetic";
+  capture::SourceOptions so;
+  so.width = config.capture.width_px;
+  so.height = config.capture.height_px;
+  so.fps = fps;
+  so.intrinsics = config.pipeline.intrinsics;
+  so.layout = config.pipeline.layout;
+  so.mount = config.pipeline.mount;
+  if (replay) {
+    spec = "replay:" + replay_dir();
+    so.replay_speed = fps / 30.0;  // the recording is 30 fps
+    so.replay_loop = true;
+  }
+
+  for (auto _ : state) {
+    auto source = capture::make_frame_source(spec, so);
+    if (!source) {
+      state.SkipWithError(source.error().message.c_str());
+      return;
+    }
+    capture::CaptureThreadOptions copts;
+    copts.realtime_priority = config.capture.rt_priority;
+    copts.cpu = config.capture.cpu;
+    capture::CaptureThread capture(std::move(source).value(), copts);
+    if (auto r = capture.start(); !r) {
+      state.SkipWithError(r.error().message.c_str());
+      return;
+    }
+    ShmOptions sopts;
+    sopts.name = "/ceilpose-latency-bench-" + std::to_string(getpid());
+    auto shm = ShmPoseWriter::create(sopts);
+    if (!shm) {
+      state.SkipWithError(shm.error().message.c_str());
+      return;
+    }
+    daemon::ProblemCounters problems;
+    daemon::ProgressCounter progress;
+    daemon::WorkerOptions wopts;
+    wopts.rt_priority = config.capture.pipeline_rt_priority;  // as ceilposed runs it
+    daemon::PipelineWorker worker(config, wopts, &capture, &*shm, nullptr, &problems, &progress);
+
+    std::unique_ptr<BusyCore> busy;
+    if (loaded) busy = std::make_unique<BusyCore>(1);
+    const auto t0 = std::chrono::steady_clock::now();
+    worker.start();
+    // Backlog growth: skipped + dropped over the second half of the run
+    // against the first half.
+    std::this_thread::sleep_for(std::chrono::duration<double>(g_duration_s / 2));
+    const capture::CaptureStats half = capture.stats();
+    std::this_thread::sleep_for(std::chrono::duration<double>(g_duration_s / 2));
+    worker.stop();
+    capture.stop();
+    busy.reset();
+    const auto t1 = std::chrono::steady_clock::now();
+    state.SetIterationTime(std::chrono::duration<double>(t1 - t0).count());
+
+    const capture::CaptureStats end = capture.stats();
+    const capture::LatencySummary lat = worker.latency().dequeue_to_published().summary();
+    const capture::LatencySummary cap = worker.latency().capture_to_published().summary();
+    state.counters["p50_us"] = static_cast<double>(lat.p50_us);
+    state.counters["p99_us"] = static_cast<double>(lat.p99_us);
+    state.counters["max_us"] = static_cast<double>(lat.max_us);
+    state.counters["cap_p99_us"] = static_cast<double>(cap.p99_us);
+    state.counters["frames"] = static_cast<double>(worker.frames());
+    const double lost_first = static_cast<double>(half.skipped + half.drops);
+    const double lost_all = static_cast<double>(end.skipped + end.drops);
+    state.counters["skipped"] = lost_all;
+    state.counters["skip_growth"] = (lost_all - lost_first) - lost_first;
+    state.counters["fifo"] = (capture.realtime().fifo ? 1 : 0) + (worker.realtime() ? 1 : 0);
+    (void)ShmPoseWriter::remove(sopts.name);
+  }
+}
+
+void register_all() {
+  for (bool replay : {false, true}) {
+    const char* name = replay ? "replay" : "synthetic";
+    benchmark::RegisterBenchmark(name, [replay](benchmark::State& s) { BM_FrameToPose(s, replay); })
+        ->ArgsProduct({{30, 60, 120}, {0, 1}})
+        ->ArgNames({"fps", "load"})
+        ->Iterations(1)
+        ->UseManualTime()
+        ->Unit(benchmark::kMillisecond);
+  }
+}
+
+}  // namespace
+}  // namespace ceilpose
+
+int main(int argc, char** argv) {
+  // Our own flag, removed before Google Benchmark sees the rest.
+  int kept = 1;
+  for (int i = 1; i < argc; ++i) {
+    if (std::strncmp(argv[i], "--duration_s=", 13) == 0) {
+      ceilpose::g_duration_s = std::atof(argv[i] + 13);
+    } else {
+      argv[kept++] = argv[i];
+    }
+  }
+  argc = kept;
+  spdlog::set_level(spdlog::level::warn);
+  benchmark::Initialize(&argc, argv);
+  ceilpose::register_all();
+  benchmark::RunSpecifiedBenchmarks();
+  benchmark::Shutdown();
+  if (!ceilpose::g_replay_dir.empty()) std::filesystem::remove_all(ceilpose::g_replay_dir);
+  return 0;
+}
