@@ -7,6 +7,7 @@
 #include <memory>
 #include <string>
 
+#include "config/service_config.h"
 #include "ctl/command_registry.h"
 #include "recording/recording_writer.h"
 #include "sim/renderer.h"
@@ -18,6 +19,7 @@ namespace {
 struct RenderArgs {
   std::string scenario;
   std::string out_dir;
+  std::string config_file;
   int frames = 100;
   uint64_t seed = 1;
   bool list = false;
@@ -42,10 +44,23 @@ void run_render(const RenderArgs& args) {
     set_exit_code(kExitUsage);
     return;
   }
-  // SPEC defaults for the ceiling and the camera; the seed places fixtures
-  // and clutter and draws the scenario's poses and noise.
+  // SPEC defaults for the ceiling, the camera and its mount unless a
+  // configuration says otherwise; the seed places fixtures and clutter and
+  // draws the scenario's poses and noise.
   sim::SceneOptions options;
   options.seed = args.seed;
+  CameraMount mount;
+  if (!args.config_file.empty()) {
+    Result<ServiceConfig> config = load_config_file(args.config_file);
+    if (!config) {
+      std::cerr << "ceilposectl render: " << config.error().message << "\n";
+      set_exit_code(kExitBadInput);
+      return;
+    }
+    options.layout = config->pipeline.layout;
+    options.intrinsics = config->pipeline.intrinsics;
+    mount = config->pipeline.mount;
+  }
   Result<sim::Scenario> scenario =
       sim::make_scenario(args.scenario, options, args.frames, args.seed);
   if (!scenario) {
@@ -70,7 +85,11 @@ void run_render(const RenderArgs& args) {
   size_t reported_tenth = 0;
   for (size_t i = 0; i < total; ++i) {
     const sim::ScenarioFrame& f = scenario->frames[i];
-    renderer.render(f.pose, f.mount, f.effects, f.seed, &frame);
+    // The configured mount, with the scenario's tilt (the `tilt` set) on top.
+    CameraMount frame_mount = mount;
+    frame_mount.tilt_x_rad += f.mount.tilt_x_rad;
+    frame_mount.tilt_y_rad += f.mount.tilt_y_rad;
+    renderer.render(f.pose, frame_mount, f.effects, f.seed, &frame);
     // JPEG artefacts are already in the pixels; PNG keeps them exactly.
     Result<void> ok = writer->append(frame.view(), f.timestamp_ns, &f.pose);
     if (!ok) {
@@ -103,13 +122,18 @@ void add_render_command(CLI::App& app) {
   CLI::App* cmd = app.add_subcommand(
       "render",
       "Render a simulated recording (SPEC §4) with ground truth (gt_x_m, gt_y_m, gt_yaw_rad) for "
-      "a named scenario set, with SPEC's default ceiling and camera (640x480, fx=fy=530).\n"
+      "a named scenario set, by default with SPEC's ceiling and camera (640x480, fx=fy=530).\n"
       "Frames are PNG, 30 fps timestamps; the same --seed gives the same recording.\n"
-      "Exit 0 on success, 2 on a bad command line or unknown scenario, 1 when writing fails.");
+      "--config takes the camera (intrinsics, distortion), its mount and the ceiling layout "
+      "from a configuration file; recording.yaml then carries that camera.\n"
+      "Exit 0 on success, 2 on a bad command line or unknown scenario, 4 on a malformed "
+      "configuration, 1 when writing fails.");
   cmd->footer("Scenarios:\n" + catalog_text());
   cmd->add_option("--scenario", args->scenario, "Scenario set to render (see below or --list)");
   cmd->add_option("--out", args->out_dir,
                   "Recording directory to create (must not exist or be empty)");
+  cmd->add_option("--config", args->config_file,
+                  "Configuration file (camera, mount, ceiling layout; SPEC defaults otherwise)");
   cmd->add_option("--frames", args->frames, "Number of frames")
       ->capture_default_str()
       ->check(CLI::PositiveNumber);

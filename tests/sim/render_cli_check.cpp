@@ -82,6 +82,41 @@ TEST_F(RenderCommandTest, WritesARecordingThatReadsBackWithGroundTruthAndExactPi
   }
 }
 
+TEST_F(RenderCommandTest, ConfigurationSetsTheCameraAndMountOfTheRecording) {
+  std::ofstream(dir_ + "/cfg.yaml") << "camera:\n  distortion: [-0.1, 0.02, 0.0, 0.0, 0.0]\n"
+                                       "mount:\n  offset_forward_m: 0.05\n  yaw_rad: 0.3\n";
+  const std::string rec = dir_ + "/rec";
+  const CtlRun r = ctl("render --scenario random --frames 2 --seed 6 --config " + dir_ +
+                       "/cfg.yaml --out " + rec);
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  Result<RecordingReader> reader = RecordingReader::open(rec);
+  ASSERT_TRUE(reader.ok()) << reader.error().message;
+  SceneOptions options;
+  options.seed = 6;
+  options.intrinsics.distortion = {-0.1, 0.02, 0.0, 0.0, 0.0};
+  EXPECT_EQ(reader->camera().intrinsics.distortion, options.intrinsics.distortion);
+  CameraMount mount;
+  mount.offset_forward_m = 0.05;
+  mount.yaw_rad = 0.3;
+  const Result<Scenario> scenario = make_scenario("random", options, 2, 6);
+  ASSERT_TRUE(scenario.ok());
+  Renderer renderer(options);
+  Image stored, rendered;
+  ASSERT_TRUE(reader->load_frame(1, &stored).ok());
+  const ScenarioFrame& f = scenario->frames[1];
+  renderer.render(f.pose, mount, f.effects, f.seed, &rendered);
+  ASSERT_EQ(stored.size_bytes(), rendered.size_bytes());
+  EXPECT_EQ(std::memcmp(stored.data(), rendered.data(), stored.size_bytes()), 0);
+}
+
+TEST_F(RenderCommandTest, MalformedConfigurationIsABadInputError) {
+  std::ofstream(dir_ + "/cfg.yaml") << "camera:\n  fx: [oops\n";
+  const CtlRun r =
+      ctl("render --scenario random --config " + dir_ + "/cfg.yaml --out " + dir_ + "/rec");
+  EXPECT_EQ(r.exit_code, 4);
+  EXPECT_NE(r.err.find("cfg.yaml"), std::string::npos);
+}
+
 TEST_F(RenderCommandTest, UnknownScenarioIsAUsageErrorThatNamesIt) {
   const CtlRun r = ctl("render --scenario nonsense --out " + dir_ + "/rec");
   EXPECT_EQ(r.exit_code, 2);
