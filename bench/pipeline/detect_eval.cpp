@@ -1,0 +1,112 @@
+// Detection quality on the simulator's named scenario sets: how many of the
+// whole markers in view are decoded, how many decoded codes are wrong, how
+// far the marker-centre points lie from the projection of the true centres,
+// and what the pipeline's own pose (auto mode) makes of them.
+//   ninja -C build detect_eval && build/bench/pipeline/detect_eval stress 200
+// Options by environment: WIDTH (320/640/1280, field of view kept), K1
+// (radial distortion k1, with k2 = 0.1·k1, in both renderer and pipeline).
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <string>
+#include <vector>
+
+#include "pipeline/pipeline.h"
+#include "sim/renderer.h"
+#include "sim/scenarios.h"
+#include "sim/visibility.h"
+
+namespace ceilpose {
+namespace {
+
+double percentile(std::vector<double> v, double p) {
+  if (v.empty()) return 0.0;
+  std::sort(v.begin(), v.end());
+  return v[std::min(v.size() - 1, static_cast<size_t>(p * static_cast<double>(v.size())))];
+}
+
+int run(const std::string& name, int frame_count) {
+  sim::SceneOptions options;
+  if (const char* w = std::getenv("WIDTH")) {
+    const int width = std::atoi(w);
+    const double scale = width / 640.0;
+    options.intrinsics.width = width;
+    options.intrinsics.height = width * 3 / 4;
+    options.intrinsics.fx = options.intrinsics.fy = 530.0 * scale;
+    options.intrinsics.cx = 0.5 * (width - 1);
+    options.intrinsics.cy = 0.5 * (width * 3 / 4 - 1);
+  }
+  if (const char* k1 = std::getenv("K1")) {
+    options.intrinsics.distortion[0] = std::atof(k1);
+    options.intrinsics.distortion[1] = 0.1 * std::atof(k1);
+  }
+  sim::Renderer renderer(options);
+  const Result<sim::Scenario> scenario = sim::make_scenario(name, options, frame_count, 7);
+  if (!scenario) {
+    std::fprintf(stderr, "detect_eval: %s\n", scenario.error().message.c_str());
+    return 2;
+  }
+  PipelineConfig config;
+  config.intrinsics = options.intrinsics;
+  Pipeline pipeline(config);
+  static FrameResult result;
+  Image image;
+  int whole = 0, found = 0, wrong = 0, frames_with_whole = 0, valid = 0, gross = 0;
+  std::vector<double> centre_err_px, pose_err_m;
+  for (const sim::ScenarioFrame& f : scenario->frames) {
+    renderer.render(f.pose, f.mount, f.effects, f.seed, &image);
+    pipeline.process(image.view(), PositioningMode::kAuto, &result);
+    const CameraPose camera = camera_pose_from_robot(f.pose, f.mount);
+    const int in_view = sim::count_whole_markers(options, f.pose, f.mount);
+    whole += in_view;
+    frames_with_whole += in_view > 0 ? 1 : 0;
+    int right = 0;
+    for (int k = 0; k < result.marker_count; ++k) {
+      const MarkerObservation& o = result.markers[k];
+      double u = 0.0, v = 0.0;
+      project_world_point(config.intrinsics, camera,
+                          config.layout.marker_centre_w(o.code_i, o.code_j), &u, &v);
+      const double err = std::hypot(o.centre_u_px - u, o.centre_v_px - v);
+      if (err > 3.0) {
+        ++wrong;
+        continue;
+      }
+      ++right;
+      centre_err_px.push_back(err);
+    }
+    found += std::min(right, in_view);
+    if (result.estimate.valid) {
+      ++valid;
+      const double e =
+          std::hypot(result.estimate.pose.x_m - f.pose.x_m, result.estimate.pose.y_m - f.pose.y_m);
+      pose_err_m.push_back(e);
+      if (e > 0.25 * config.layout.grid_m) ++gross;
+    }
+  }
+  const PipelineCounters& c = pipeline.counters();
+  std::printf(
+      "%-12s frames %4zu | whole markers %5d decoded %5d (%.1f %%) wrong codes %d | centre error "
+      "median %.3f p99 %.3f px | valid %d/%d frames, position error median %.2f p99 %.2f mm, "
+      "gross %d | refused: cut %lu blurred %lu ambiguous %lu inconsistent %lu\n",
+      name.c_str(), scenario->frames.size(), whole, found, whole ? 100.0 * found / whole : 0.0,
+      wrong, percentile(centre_err_px, 0.5), percentile(centre_err_px, 0.99), valid,
+      frames_with_whole, 1e3 * percentile(pose_err_m, 0.5), 1e3 * percentile(pose_err_m, 0.99),
+      gross, static_cast<unsigned long>(c.cut_markers),
+      static_cast<unsigned long>(c.blurred_markers), static_cast<unsigned long>(c.ambiguous_codes),
+      static_cast<unsigned long>(c.inconsistent_markers));
+  return 0;
+}
+
+}  // namespace
+}  // namespace ceilpose
+
+int main(int argc, char** argv) {
+  if (argc < 2 || std::string(argv[1]) == "--help") {
+    std::printf("usage: detect_eval SCENARIO [FRAMES]   (env WIDTH, K1)\nscenarios:\n");
+    for (const auto& [name, description] : ceilpose::sim::scenario_catalog())
+      std::printf("  %-14s %s\n", name.c_str(), description.c_str());
+    return argc < 2 ? 2 : 0;
+  }
+  return ceilpose::run(argv[1], argc > 2 ? std::atoi(argv[2]) : 100);
+}
