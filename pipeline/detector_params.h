@@ -94,12 +94,12 @@ struct DetectorParams {
   // the red rectangle's ends, 25–75 % rise) exceeds this fraction of the red
   // dot's height in pixels: such blur can wash a 1 in dot out completely,
   // and an unset slot then looks confidently unset. Sharp edges spread
-  // 0.5 px. Trade-off measured on the simulator: at 640×480 (6.3 px dots)
-  // 0.6 keeps every marker of the stress and defocus sets and 86 % of the
-  // frames of the 2–10 px motion-blur set (94 % with no limit, 77 % at
-  // 0.45); at 320×240 under stress levels (3 px dots, JPEG) it refuses most
-  // markers but still lets a few misread ones through (0.45 lets none).
-  float max_blur_to_dot = 0.6f;
+  // 0.5 px. Measured on the simulator: at 640×480 (6.3 px dots) 0.75 refuses
+  // nothing of the stress, defocus and 2–10 px motion-blur sets; at 320×240
+  // under stress levels (3 px dots, JPEG 60) it refuses some markers and
+  // 2 of ~340 decoded still carry a wrong code (0.6: 1, at the cost of 8 %
+  // of the motion-blur frames at 640×480).
+  float max_blur_to_dot = 0.75f;
 };
 
 }  // namespace ceilpose

@@ -14,10 +14,11 @@
 // give. The scale comes from the long sides (12 in), which thresholding
 // shortens least in relative terms.
 //
-// Read_Dots. A slot holds a dot when the brightness (max of R, G, B) at the
-// slot, averaged bilinearly over a 3 × 3 grid on the dot's core, falls
-// below `dot_threshold_ratio` of the rectangle's own brightness, measured the
-// same way half-way between slots where no dot is ever printed. A ratio of
+// Read_Dots. A slot holds a dot when its brightness, sampled bilinearly on
+// the dot's core, falls below `dot_threshold_ratio` of the rectangle's own
+// brightness, measured the same way half-way between slots where no dot is
+// ever printed. Brightness is taken both as the brightest channel and as
+// luma, and the lower ratio counts (see brightness_at). A ratio of
 // two readings of the same frame is independent of exposure; a printed dot
 // reads ≈ 0.13–0.16 of its rectangle when sharp, and ≈ 0.5 only under blur
 // that would also hide the marker.
@@ -25,52 +26,60 @@
 namespace ceilpose {
 namespace {
 
-// Brightness (max of R, G, B) at an image point, bilinear between pixels.
-// Returns −1 outside the frame.
-double brightness_at(const ImageView& frame, double u, double v) {
+// Two brightness measures at an image point, bilinear between pixels:
+// [0] the brightest channel, where a dot contrasts most with its colour
+// (25 against 200 or 160), and [1] luma, which YUYV and JPEG keep at full
+// resolution when they halve the chroma that carries most of a red dot's
+// contrast. {−1, −1} outside the frame.
+using Brightness = std::array<double, 2>;
+
+Brightness brightness_at(const ImageView& frame, double u, double v) {
   const int x0 = static_cast<int>(std::floor(u)), y0 = static_cast<int>(std::floor(v));
-  if (x0 < 0 || y0 < 0 || x0 + 1 >= frame.width || y0 + 1 >= frame.height) return -1.0;
+  if (x0 < 0 || y0 < 0 || x0 + 1 >= frame.width || y0 + 1 >= frame.height) return {-1.0, -1.0};
   const double fu = u - x0, fv = v - y0;
-  double level[4];
+  const double w[4] = {(1 - fu) * (1 - fv), fu * (1 - fv), (1 - fu) * fv, fu * fv};
+  Brightness out{0.0, 0.0};
   for (int k = 0; k < 4; ++k) {
     uint8_t r = 0, g = 0, b = 0;
     read_rgb(frame, x0 + (k & 1), y0 + (k >> 1), &r, &g, &b);
-    level[k] = std::max({r, g, b});
+    out[0] += w[k] * std::max({r, g, b});
+    out[1] += w[k] * (0.299 * r + 0.587 * g + 0.114 * b);
   }
-  return (1 - fv) * ((1 - fu) * level[0] + fu * level[1]) +
-         fv * ((1 - fu) * level[2] + fu * level[3]);
+  return out;
 }
 
 // Mean brightness over a 3 × 3 grid of points around marker point (e, n),
-// spread ±(spread_e_m, spread_n_m). Returns −1 when a point is outside.
-double patch_brightness(const ImageView& frame, const MarkerFrame& m, double e_m, double n_m,
-                        double spread_e_m, double spread_n_m) {
-  double sum = 0.0;
+// spread ±(spread_e_m, spread_n_m). Negative when a point is outside.
+Brightness patch_brightness(const ImageView& frame, const MarkerFrame& m, double e_m, double n_m,
+                            double spread_e_m, double spread_n_m) {
+  Brightness sum{0.0, 0.0};
   for (int ie = -1; ie <= 1; ++ie) {
     for (int in = -1; in <= 1; ++in) {
       double u = 0.0, v = 0.0;
       m.project(e_m + ie * spread_e_m, n_m + in * spread_n_m, &u, &v);
-      const double b = brightness_at(frame, u, v);
-      if (b < 0.0) return -1.0;
-      sum += b;
+      const Brightness b = brightness_at(frame, u, v);
+      if (b[0] < 0.0) return {-1.0, -1.0};
+      sum[0] += b[0] / 9.0;
+      sum[1] += b[1] / 9.0;
     }
   }
-  return sum / 9.0;
+  return sum;
 }
 
 // Mean brightness of three points across a slot: (e − spread, n), (e, n),
-// (e + spread, n). Returns −1 when a point is outside.
-double line_brightness(const ImageView& frame, const MarkerFrame& m, double e_m, double n_m,
-                       double spread_e_m) {
-  double sum = 0.0;
+// (e + spread, n). Negative when a point is outside.
+Brightness line_brightness(const ImageView& frame, const MarkerFrame& m, double e_m, double n_m,
+                           double spread_e_m) {
+  Brightness sum{0.0, 0.0};
   for (int ie = -1; ie <= 1; ++ie) {
     double u = 0.0, v = 0.0;
     m.project(e_m + ie * spread_e_m, n_m, &u, &v);
-    const double b = brightness_at(frame, u, v);
-    if (b < 0.0) return -1.0;
-    sum += b;
+    const Brightness b = brightness_at(frame, u, v);
+    if (b[0] < 0.0) return {-1.0, -1.0};
+    sum[0] += b[0] / 3.0;
+    sum[1] += b[1] / 3.0;
   }
-  return sum / 3.0;
+  return sum;
 }
 
 }  // namespace
@@ -108,20 +117,21 @@ CodeReading read_code(const ImageView& frame, const MarkerFrame& marker, bool re
   // Reference: half-way between slots (and beyond the end slots while that
   // stays 1 in inside the rectangle).
   const double limit_n_m = 0.5 * layout.rect_height_m - kInch_m;
-  double ref_sum = 0.0;
+  Brightness ref_sum{0.0, 0.0};
   int ref_count = 0;
   for (int k = 0; k <= layout.bits; ++k) {
     const double n_m = layout.slot_n_m(0) + 0.5 * layout.slot_pitch_m - k * layout.slot_pitch_m;
     if (std::abs(n_m) > limit_n_m) continue;
-    const double b =
+    const Brightness b =
         patch_brightness(frame, marker, e_m, n_m, 0.25 * layout.rect_width_m, 0.1 * dot_n_m);
-    if (b < 0.0) return out;
-    ref_sum += b;
+    if (b[0] < 0.0) return out;
+    ref_sum[0] += b[0];
+    ref_sum[1] += b[1];
     ++ref_count;
   }
   if (ref_count == 0) return out;
-  const double reference = ref_sum / ref_count;
-  if (reference < 1.0) return out;
+  const Brightness reference{ref_sum[0] / ref_count, ref_sum[1] / ref_count};
+  if (reference[0] < 1.0 || reference[1] < 1.0) return out;
   const double px_per_m = std::hypot(marker.north_u, marker.north_v);
   // One pixel, or a sixth of the dot's height in large images.
   const double step_m = std::max(px_per_m > 0.0 ? 1.0 / px_per_m : params.dot_search_m,
@@ -135,14 +145,16 @@ CodeReading read_code(const ImageView& frame, const MarkerFrame& marker, bool re
     // along North; the darkest is the dot's core wherever blur, a rectangle
     // eaten by glare or a slightly wrong scale put it. The search stays
     // clear of the neighbouring slots' dots (pitch 4 in).
-    double b = -1.0;
+    // The slot's ratio is the lower of the two measures' ratios: each is
+    // ≈ 1 on an empty slot, and a dot darkens both.
+    double ratio = -1.0;
     for (int step = -search_steps; step <= search_steps; ++step) {
-      const double line =
+      const Brightness line =
           line_brightness(frame, marker, e_m, layout.slot_n_m(k) + step * step_m, 0.25 * dot_e_m);
-      if (line < 0.0) return out;
-      b = b < 0.0 ? line : std::min(b, line);
+      if (line[0] < 0.0) return out;
+      const double r = std::min(line[0] / reference[0], line[1] / reference[1]);
+      ratio = ratio < 0.0 ? r : std::min(ratio, r);
     }
-    const double ratio = b / reference;
     out.ratio[k] = static_cast<float>(ratio);
     if (ratio < params.dot_threshold_ratio) code |= 1 << (layout.bits - 1 - k);
     margin = std::min(margin, std::abs(ratio - params.dot_threshold_ratio));

@@ -193,7 +193,7 @@ TEST_F(PipelineDetectTest, BadFramesGiveAnInvalidPoseWithoutCrashing) {
 }
 
 TEST_F(PipelineDetectTest, MarkerBlurredBeyondItsRedDotsIsRefusedNotMisread) {
-  // Half-size markers (3 px red dots) under 5 px of blur along North: the
+  // Half-size markers (3 px red dots) under 7 px of blur along North: the
   // red dots wash out, so the marker must not be decoded at all.
   PipelineConfig small = config;
   small.intrinsics = {320, 240, 265.0, 265.0, 159.5, 119.5, {}};
@@ -212,9 +212,9 @@ TEST_F(PipelineDetectTest, MarkerBlurredBeyondItsRedDotsIsRefusedNotMisread) {
     for (int x = 0; x < 320; ++x) {
       for (int c = 0; c < 3; ++c) {
         int sum = 0;
-        for (int k = -2; k <= 2; ++k)
+        for (int k = -3; k <= 3; ++k)
           sum += sharp.data()[y * 960 + 3 * std::clamp(x + k, 0, 319) + c];
-        blurred.row(y)[3 * x + c] = static_cast<uint8_t>(sum / 5);
+        blurred.row(y)[3 * x + c] = static_cast<uint8_t>(sum / 7);
       }
     }
   }
