@@ -1,5 +1,9 @@
 #include <gtest/gtest.h>
 
+#include <chrono>
+#include <thread>
+
+#include "core/clock.h"
 #include "ipc/dds/dds_pose_publisher.h"
 #include "tests/ipc/dds/dds_test_env.h"
 
@@ -42,13 +46,45 @@ TEST_F(DdsPublisher, InvalidPoseIsCountedNotPublished) {
   EXPECT_EQ(pub->published(), 1u);
 }
 
-TEST_F(DdsPublisher, StatusIsPublishedWithoutFix) {
+TEST_F(DdsPublisher, StatusWithoutFixReachesAReaderWithItsFigures) {
   auto pub = DdsPosePublisher::create(options_);
   ASSERT_TRUE(pub.ok()) << pub.error().message;
+  auto participant = DdsParticipant::create(options_.domain);
+  ASSERT_TRUE(participant.ok()) << participant.error().message;
+  const dds_entity_t topic =
+      dds_create_topic(participant->handle(), &ceilpose_msg_dds__Status__desc,
+                       pub->status_topic().c_str(), nullptr, nullptr);
+  ASSERT_GT(topic, 0);
+  const dds_entity_t reader = dds_create_reader(participant->handle(), topic, nullptr, nullptr);
+  ASSERT_GT(reader, 0);
   DdsStatus status;
   status.fix = false;
   status.health = DdsHealth::kDegraded;
-  EXPECT_TRUE(pub->publish_status(status).ok());
+  status.fps = 12.5f;
+  status.drops = 7;
+  status.latency_p99_us = 900;
+
+  // The writer drops what it writes before it has matched the reader: keep
+  // publishing (bounded) until a sample arrives.
+  ceilpose_msg_dds__Status_ msg{};
+  void* samples[1] = {&msg};
+  dds_sample_info_t info{};
+  bool received = false;
+  const int64_t deadline_ns = monotonic_ns() + 10'000'000'000;
+  while (!received && monotonic_ns() < deadline_ns) {
+    ASSERT_TRUE(pub->publish_status(status).ok());
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));
+    received = dds_take(reader, samples, &info, 1, 1) == 1 && info.valid_data;
+  }
+
+  ASSERT_TRUE(received);
+  EXPECT_FALSE(msg.fix);
+  EXPECT_EQ(msg.health, static_cast<uint8_t>(DdsHealth::kDegraded));
+  EXPECT_STREQ(msg.robot, options_.robot.c_str());
+  EXPECT_FLOAT_EQ(msg.fps, 12.5f);
+  EXPECT_EQ(msg.drops, 7u);
+  EXPECT_EQ(msg.latency_p99_us, 900u);
+  dds_sample_free(&msg, &ceilpose_msg_dds__Status__desc, DDS_FREE_CONTENTS);
 }
 
 TEST_F(DdsPublisher, DisposedPublisherRefusesToPublish) {
