@@ -154,7 +154,8 @@ void PipelineWorker::process(const capture::Frame& frame) {
   }
 #endif
   stamps.published_ns = monotonic_ns();
-  latency_.record(stamps);
+  if (frames_.load(std::memory_order_relaxed) >= options_.latency_warmup_frames)
+    latency_.record(stamps);
 
   // 4. Hand the control thread a snapshot, unless it is reading right now.
   last_.seq = shm_->last_seq();

@@ -55,6 +55,9 @@ struct WorkerOptions {
   // many frames the thread stops making progress until stop(), as a hung
   // pipeline would. 0 = never.
   uint64_t stall_after_frames = 0;
+  // Frames whose latency is not recorded: the first ones after start touch
+  // the pipeline's buffers for the first time (benchmarks skip them).
+  uint64_t latency_warmup_frames = 0;
 };
 
 class PipelineWorker {

@@ -37,6 +37,8 @@ namespace ceilpose {
 namespace {
 
 double g_duration_s = 2.0;
+// Frames not recorded: the first touch of the pipeline's buffers is not the steady state.
+constexpr uint64_t kWarmupFrames = 5;
 std::string g_replay_dir;
 
 // Spins on one CPU until destroyed: "the other core loaded".
@@ -134,6 +136,7 @@ void BM_FrameToPose(benchmark::State& state, bool replay) {
     daemon::ProgressCounter progress;
     daemon::WorkerOptions wopts;
     wopts.rt_priority = config.capture.pipeline_rt_priority;  // as ceilposed runs it
+    wopts.latency_warmup_frames = kWarmupFrames;
     daemon::PipelineWorker worker(config, wopts, &capture, &*shm, nullptr, &problems, &progress);
 
     std::unique_ptr<BusyCore> busy;
