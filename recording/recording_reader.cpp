@@ -53,29 +53,35 @@ std::string quoted(std::string_view text) {
 
 int line_of(const YAML::Node& node) { return node.Mark().line + 1; }
 
+// Keys under `camera` are named "camera.<key>" in messages.
+std::string key_name(const char* parent_key, const char* key) {
+  return std::string(parent_key) + (*parent_key != '\0' ? "." : "") + key;
+}
+
 template <typename T>
-Result<T> yaml_scalar(const YAML::Node& parent, const char* key, const std::string& where,
-                      const char* expected) {
+Result<T> yaml_scalar(const YAML::Node& parent, const char* parent_key, const char* key,
+                      const std::string& where, const char* expected) {
   const YAML::Node node = parent[key];
   if (!node.IsDefined() || node.IsNull()) {
-    return make_error(where + ":" + std::to_string(line_of(parent)) + ": missing key '" + key +
-                      "'");
+    return make_error(where + ":" + std::to_string(line_of(parent)) + ": missing key '" +
+                      key_name(parent_key, key) + "'");
   }
   T value{};
   if (!node.IsScalar() || !YAML::convert<T>::decode(node, value)) {
-    return make_error(where + ":" + std::to_string(line_of(node)) + ": key '" + key + "' must be " +
-                      expected);
+    return make_error(where + ":" + std::to_string(line_of(node)) + ": key '" +
+                      key_name(parent_key, key) + "' must be " + expected);
   }
   return value;
 }
 
-Result<double> yaml_finite(const YAML::Node& parent, const char* key, const std::string& where,
-                           bool positive) {
-  auto v = yaml_scalar<double>(parent, key, where, positive ? "a positive number" : "a number");
+Result<double> yaml_camera_number(const YAML::Node& camera, const char* key,
+                                  const std::string& where, bool positive) {
+  const char* expected = positive ? "a positive number" : "a finite number";
+  auto v = yaml_scalar<double>(camera, "camera", key, where, expected);
   if (!v) return v;
   if (!std::isfinite(*v) || (positive && *v <= 0.0)) {
-    return make_error(where + ":" + std::to_string(line_of(parent[key])) + ": key '" + key +
-                      "' must be " + (positive ? "a positive number" : "a finite number"));
+    return make_error(where + ":" + std::to_string(line_of(camera[key])) + ": key 'camera." + key +
+                      "' must be " + expected);
   }
   return v;
 }
@@ -97,13 +103,13 @@ Result<RecordingCamera> parse_yaml(const std::string& path) {
   if (!root.IsMap()) {
     return make_error(path + ":1: expected a mapping with keys format, version, camera");
   }
-  auto format = yaml_scalar<std::string>(root, "format", path, "a string");
+  auto format = yaml_scalar<std::string>(root, "", "format", path, "a string");
   if (!format) return format.error();
   if (*format != fmt::kFormat) {
     return make_error(path + ":" + std::to_string(line_of(root["format"])) + ": format " +
                       quoted(*format) + " is not '" + fmt::kFormat + "'");
   }
-  auto version = yaml_scalar<int>(root, "version", path, "an integer");
+  auto version = yaml_scalar<int>(root, "", "version", path, "an integer");
   if (!version) return version.error();
   if (*version != fmt::kVersion) {
     return make_error(path + ":" + std::to_string(line_of(root["version"])) +
@@ -121,9 +127,8 @@ Result<RecordingCamera> parse_yaml(const std::string& path) {
   }
   RecordingCamera out;
   CameraIntrinsics& k = out.intrinsics;
-  const std::string cam_where = path;
   for (auto [key, dst] : {std::pair{"width", &k.width}, std::pair{"height", &k.height}}) {
-    auto v = yaml_scalar<int>(cam, key, cam_where, "a positive integer");
+    auto v = yaml_scalar<int>(cam, "camera", key, path, "a positive integer");
     if (!v) return v.error();
     if (*v <= 0) {
       return make_error(path + ":" + std::to_string(line_of(cam[key])) + ": key 'camera." + key +
@@ -134,7 +139,7 @@ Result<RecordingCamera> parse_yaml(const std::string& path) {
   for (auto [key, dst, positive] :
        {std::tuple{"fx", &k.fx, true}, std::tuple{"fy", &k.fy, true},
         std::tuple{"cx", &k.cx, false}, std::tuple{"cy", &k.cy, false}}) {
-    auto v = yaml_finite(cam, key, cam_where, positive);
+    auto v = yaml_camera_number(cam, key, path, positive);
     if (!v) return v.error();
     *dst = *v;
   }

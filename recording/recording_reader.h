@@ -3,6 +3,12 @@
 // one PNG or JPEG file per frame. open() validates everything but the pixels;
 // load_frame() checks one frame file's structure and decodes it.
 //
+// Beyond SPEC §4 the reader accepts, without loss of strictness: extra
+// columns in any order, RFC 4180 quoted fields, CRLF line ends, a UTF-8
+// byte-order mark, blank lines at the very end, a row whose three gt_* fields
+// are all empty (that frame has no ground truth), `distortion` omitted (none),
+// palette PNGs (decoded to RGB). Everything else that departs is an error.
+//
 // Thread safety: a reader may be used from one thread at a time (load_frame
 // reuses internal buffers so that replay does not allocate per frame).
 #include <cstddef>

@@ -111,7 +111,7 @@ struct RecordingWriter::State {
   std::vector<uint8_t> encoded;  // reused encoder output
   cv::Mat bgr;                   // reused RGB->BGR conversion buffer
   std::vector<int> encode_params;
-  std::string row;  // reused CSV row text
+  std::string path;  // reused frame file path
 };
 
 RecordingWriter::RecordingWriter() : s_(std::make_unique<State>()) {}
@@ -161,31 +161,33 @@ Result<void> RecordingWriter::append(const ImageView& frame, int64_t timestamp_n
                                      const Pose2D* ground_truth, int jpeg_quality) {
   if (!s_ || s_->closed) return make_error("recording writer: append() after close()");
   State& s = *s_;
-  const std::string frame_name = "frame " + std::to_string(s.frames) + " of " + s.dir;
-  if (frame.data == nullptr) return make_error(frame_name + ": empty image");
+  // Built only for an error: the success path allocates nothing of its own.
+  const auto frame_name = [&s] { return "frame " + std::to_string(s.frames) + " of " + s.dir; };
+  if (frame.data == nullptr) return make_error(frame_name() + ": empty image");
   const CameraIntrinsics& k = s.camera.intrinsics;
   if (frame.width != k.width || frame.height != k.height) {
-    return make_error(frame_name + ": image is " + std::to_string(frame.width) + "x" +
+    return make_error(frame_name() + ": image is " + std::to_string(frame.width) + "x" +
                       std::to_string(frame.height) + ", the recording's camera is " +
                       std::to_string(k.width) + "x" + std::to_string(k.height));
   }
   if (s.frames > 0 && timestamp_ns < s.last_timestamp_ns) {
-    return make_error(frame_name + ": timestamp_ns " + std::to_string(timestamp_ns) +
+    return make_error(frame_name() + ": timestamp_ns " + std::to_string(timestamp_ns) +
                       " goes backwards (previous " + std::to_string(s.last_timestamp_ns) + ")");
   }
-  if (s.frames == 0) s.ground_truth_columns = ground_truth != nullptr;
-  if ((ground_truth != nullptr) != s.ground_truth_columns) {
-    return make_error(frame_name + (s.ground_truth_columns
-                                        ? ": no ground truth, but the first frame had it"
-                                        : ": has ground truth, but the first frame had none"));
+  // The first frame fixes the header; later frames must agree with it.
+  const bool gt_columns = s.frames == 0 ? ground_truth != nullptr : s.ground_truth_columns;
+  if ((ground_truth != nullptr) != gt_columns) {
+    return make_error(frame_name() + (gt_columns
+                                          ? ": no ground truth, but the first frame had it"
+                                          : ": has ground truth, but the first frame had none"));
   }
   if (ground_truth != nullptr &&
       !(std::isfinite(ground_truth->x_m) && std::isfinite(ground_truth->y_m) &&
         std::isfinite(ground_truth->yaw_rad))) {
-    return make_error(frame_name + ": ground truth is not finite");
+    return make_error(frame_name() + ": ground truth is not finite");
   }
   if (jpeg_quality < 0 || jpeg_quality > 100) {
-    return make_error(frame_name + ": jpeg_quality " + std::to_string(jpeg_quality) +
+    return make_error(frame_name() + ": jpeg_quality " + std::to_string(jpeg_quality) +
                       " outside 0..100 (0 writes PNG)");
   }
 
@@ -196,11 +198,11 @@ Result<void> RecordingWriter::append(const ImageView& frame, int64_t timestamp_n
     // Stored as the camera delivered it; checked so the recording stays readable.
     auto info = inspect_frame_bytes(frame.data, frame.size_bytes);
     if (!info || info->encoding != FrameEncoding::kJpeg) {
-      return make_error(frame_name + ": MJPEG payload is not a complete JPEG" +
+      return make_error(frame_name() + ": MJPEG payload is not a complete JPEG" +
                         (info ? std::string() : " (" + info.error().message + ")"));
     }
     if (info->width != k.width || info->height != k.height) {
-      return make_error(frame_name + ": MJPEG payload is " + std::to_string(info->width) + "x" +
+      return make_error(frame_name() + ": MJPEG payload is " + std::to_string(info->width) + "x" +
                         std::to_string(info->height) + ", the recording's camera is " +
                         std::to_string(k.width) + "x" + std::to_string(k.height));
     }
@@ -225,7 +227,7 @@ Result<void> RecordingWriter::append(const ImageView& frame, int64_t timestamp_n
         src = s.bgr;
         break;
       default:
-        return make_error(frame_name + ": cannot store pixel format " + to_string(frame.format) +
+        return make_error(frame_name() + ": cannot store pixel format " + to_string(frame.format) +
                           " (RGB24, BGR24, GREY or MJPEG)");
     }
     s.encode_params.clear();
@@ -237,10 +239,10 @@ Result<void> RecordingWriter::append(const ImageView& frame, int64_t timestamp_n
     }
     try {
       if (!cv::imencode(jpeg ? ".jpg" : ".png", src, s.encoded, s.encode_params)) {
-        return make_error(frame_name + ": encoder failed");
+        return make_error(frame_name() + ": encoder failed");
       }
     } catch (const cv::Exception& e) {
-      return make_error(frame_name + ": encoder failed (" + e.what() + ")");
+      return make_error(frame_name() + ": encoder failed (" + e.what() + ")");
     }
     bytes = s.encoded.data();
     size = s.encoded.size();
@@ -248,23 +250,37 @@ Result<void> RecordingWriter::append(const ImageView& frame, int64_t timestamp_n
 
   char name[32];
   std::snprintf(name, sizeof name, "%s/%06zu.%s", fmt::kFramesDir, s.frames, jpeg ? "jpg" : "png");
-  auto wrote = write_file(s.dir + "/" + name, bytes, size);
+  s.path.assign(s.dir);
+  s.path += '/';
+  s.path += name;
+  auto wrote = write_file(s.path, bytes, size);
   if (!wrote) return wrote;
 
   if (s.frames == 0) {
-    std::fputs(s.ground_truth_columns ? "index,timestamp_ns,file,gt_x_m,gt_y_m,gt_yaw_rad\n"
-                                      : "index,timestamp_ns,file\n",
+    s.ground_truth_columns = gt_columns;
+    std::fputs(gt_columns ? "index,timestamp_ns,file,gt_x_m,gt_y_m,gt_yaw_rad\n"
+                          : "index,timestamp_ns,file\n",
                s.csv.get());
   }
-  s.row = std::to_string(s.frames) + "," + std::to_string(timestamp_ns) + "," + name;
+  // index,timestamp_ns,file[,gt_x_m,gt_y_m,gt_yaw_rad]: at most 3 x 20 digits,
+  // the name and 3 x 24 characters of shortest round-trip doubles.
+  std::array<char, 192> row{};
+  char* p = row.data();
+  char* const end = row.data() + row.size() - 1;
+  p = std::to_chars(p, end, s.frames).ptr;
+  *p++ = ',';
+  p = std::to_chars(p, end, timestamp_ns).ptr;
+  *p++ = ',';
+  for (const char* c = name; *c != '\0'; ++c) *p++ = *c;
   if (ground_truth != nullptr) {
     for (const double v : {ground_truth->x_m, ground_truth->y_m, ground_truth->yaw_rad}) {
-      s.row += ',';
-      s.row += number_text(v);
+      *p++ = ',';
+      p = std::to_chars(p, end, v).ptr;
     }
   }
-  s.row += "\n";
-  if (std::fputs(s.row.c_str(), s.csv.get()) < 0) {
+  *p++ = '\n';
+  if (std::fwrite(row.data(), 1, static_cast<size_t>(p - row.data()), s.csv.get()) !=
+      static_cast<size_t>(p - row.data())) {
     return make_error(s.dir + "/" + fmt::kCsvName + ": write error (" + std::strerror(errno) + ")");
   }
   s.last_timestamp_ns = timestamp_ns;

@@ -181,15 +181,15 @@ std::vector<MalformedCase> make_cases() {
   c.push_back({"MissingCameraKey",
                png,
                [=](const std::string& d) { replace_line(yaml(d), 6, ""); },
-               {"recording.yaml:4", "missing key 'fx'"}});
+               {"recording.yaml:4", "missing key 'camera.fx'"}});
   c.push_back({"NonNumericCameraWidth",
                png,
                [=](const std::string& d) { replace_line(yaml(d), 4, "  width: wide"); },
-               {"recording.yaml:4", "'width'"}});
+               {"recording.yaml:4", "'camera.width'"}});
   c.push_back({"NegativeFocalLength",
                png,
                [=](const std::string& d) { replace_line(yaml(d), 7, "  fy: -530"); },
-               {"recording.yaml:7", "'fy'", "positive"}});
+               {"recording.yaml:7", "'camera.fy'", "positive"}});
   c.push_back({"DistortionWithTwoCoefficients",
                png,
                [=](const std::string& d) { replace_line(yaml(d), 10, "  distortion: [0.1, 0]"); },
