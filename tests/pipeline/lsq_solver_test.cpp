@@ -184,5 +184,19 @@ TEST(LeastSquares, RemovesMountOffsetAndYawWithDistortion) {
   EXPECT_NEAR(wrap_angle_rad(est.pose.yaw_rad - robot.yaw_rad), 0.0, 1e-5);
 }
 
+TEST(LeastSquares, EstimatesLensHeightWhenAsked) {
+  PipelineConfig config;
+  config.mount.lens_height_m = 0.25;  // configured wrong by 5.5 cm
+  config.positioning.lsq_estimate_height = true;
+  Positioner positioner(config);
+  testing::SyntheticView view;  // the true lens height is SPEC's 0.3048 m
+  const Pose2D robot{2.0, 2.3, -0.4};
+  const PoseEstimate est =
+      positioner.solve(testing::observe(view, robot), PositioningMode::kLeastSquares);
+  ASSERT_TRUE(est.valid);
+  EXPECT_NEAR(positioner.last_lsq().lens_height_m, 0.3048, 1e-4);
+  EXPECT_LT(position_error_m(est, robot), 1e-4);
+}
+
 }  // namespace
 }  // namespace ceilpose
