@@ -110,6 +110,32 @@ Image render_markers(int width_px, int height_px, std::span<const CraftedMarker>
   return out;
 }
 
+Image blur_rows(const Image& rgb, int length_px) {
+  Image out = rgb;
+  for (int y = 0; y < rgb.height(); ++y) {
+    const uint8_t* s = rgb.data() + static_cast<size_t>(y) * rgb.stride_bytes();
+    for (int x = 0; x < rgb.width(); ++x) {
+      for (int c = 0; c < 3; ++c) {
+        int sum = 0;
+        for (int k = -length_px / 2; k <= length_px / 2; ++k)
+          sum += s[3 * std::clamp(x + k, 0, rgb.width() - 1) + c];
+        out.row(y)[3 * x + c] = static_cast<uint8_t>(sum / (2 * (length_px / 2) + 1));
+      }
+    }
+  }
+  return out;
+}
+
+CameraIntrinsics half_size_camera() {
+  CameraIntrinsics k;
+  k.width = 320;
+  k.height = 240;
+  k.fx = k.fy = 265.0;
+  k.cx = 159.5;
+  k.cy = 119.5;
+  return k;
+}
+
 Image convert_rgb(const Image& rgb, PixelFormat format) {
   Image out(rgb.width(), rgb.height(), format);
   for (int y = 0; y < rgb.height(); ++y) {

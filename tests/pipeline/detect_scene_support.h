@@ -6,6 +6,7 @@
 #include <array>
 #include <span>
 
+#include "core/camera_model.h"
 #include "core/ceiling_layout.h"
 #include "core/image.h"
 
@@ -35,6 +36,13 @@ Image render_markers(int width_px, int height_px, std::span<const CraftedMarker>
 // The same pixels as BGR24, YUYV (BT.601 limited range, chroma averaged over
 // each pixel pair) or GRAY8.
 Image convert_rgb(const Image& rgb, PixelFormat format);
+
+// RGB24 image box-blurred over `length_px` pixels along rows (North at
+// yaw 0), edges clamped.
+Image blur_rows(const Image& rgb, int length_px);
+
+// The default camera at half resolution (320 × 240, same field of view).
+CameraIntrinsics half_size_camera();
 
 // Pixel (x, y) of an RGB24 image set to (r, g, b).
 void put_rgb(Image* image, int x, int y, Rgb colour);

@@ -89,25 +89,6 @@ TEST_F(DotReaderTest, MarkerReachingOutOfTheFrameIsNotRead) {
   EXPECT_FALSE(read_code(image.view(), frame_of(m, layout), false, layout, params).ok);
 }
 
-// Box blur of `length_px` pixels along image rows (North at yaw 0).
-Image blur_rows(const Image& in, int length_px) {
-  Image out = in;
-  for (int y = 0; y < in.height(); ++y) {
-    for (int x = 0; x < in.width(); ++x) {
-      for (int c = 0; c < 3; ++c) {
-        int sum = 0, n = 0;
-        for (int k = -length_px / 2; k <= length_px / 2; ++k) {
-          const int xx = std::clamp(x + k, 0, in.width() - 1);
-          sum += in.data()[static_cast<size_t>(y) * in.stride_bytes() + 3 * xx + c];
-          ++n;
-        }
-        out.row(y)[3 * x + c] = static_cast<uint8_t>(sum / n);
-      }
-    }
-  }
-  return out;
-}
-
 TEST_F(DotReaderTest, EdgeSpreadGrowsWithBlurAlongNorth) {
   test::CraftedMarker m;
   m.centre_u_px = 160.2;
@@ -117,7 +98,7 @@ TEST_F(DotReaderTest, EdgeSpreadGrowsWithBlurAlongNorth) {
   const double sharp_px = edge_spread_px(sharp.view(), f, true, layout);
   ASSERT_GT(sharp_px, 0.0);
   EXPECT_LT(sharp_px, 1.0);
-  const double blurred_px = edge_spread_px(blur_rows(sharp, 7).view(), f, true, layout);
+  const double blurred_px = edge_spread_px(test::blur_rows(sharp, 7).view(), f, true, layout);
   EXPECT_GT(blurred_px, 2.5);
   EXPECT_LT(blurred_px, 5.0);
 }

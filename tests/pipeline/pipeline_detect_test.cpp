@@ -196,7 +196,7 @@ TEST_F(PipelineDetectTest, MarkerBlurredBeyondItsRedDotsIsRefusedNotMisread) {
   // Half-size markers (3 px red dots) under 7 px of blur along North: the
   // red dots wash out, so the marker must not be decoded at all.
   PipelineConfig small = config;
-  small.intrinsics = {320, 240, 265.0, 265.0, 159.5, 119.5, {}};
+  small.intrinsics = test::half_size_camera();
   Pipeline half(small);
   test::CraftedMarker m;
   m.centre_u_px = 160.3;
@@ -207,17 +207,7 @@ TEST_F(PipelineDetectTest, MarkerBlurredBeyondItsRedDotsIsRefusedNotMisread) {
                                            0.5 * test::kDefaultPxPerM);
   half.process(sharp.view(), PositioningMode::kAuto, &result);
   ASSERT_EQ(result.marker_count, 1);
-  Image blurred = sharp;
-  for (int y = 0; y < 240; ++y) {
-    for (int x = 0; x < 320; ++x) {
-      for (int c = 0; c < 3; ++c) {
-        int sum = 0;
-        for (int k = -3; k <= 3; ++k)
-          sum += sharp.data()[y * 960 + 3 * std::clamp(x + k, 0, 319) + c];
-        blurred.row(y)[3 * x + c] = static_cast<uint8_t>(sum / 7);
-      }
-    }
-  }
+  const Image blurred = test::blur_rows(sharp, 7);
   half.process(blurred.view(), PositioningMode::kAuto, &result);
   EXPECT_EQ(result.marker_count, 0);
   EXPECT_EQ(half.counters().blurred_markers, 1u);
@@ -247,11 +237,7 @@ TEST_F(PipelineDetectTest, StageTimesAddUpToTheFrameTime) {
 
 TEST_F(PipelineDetectTest, NewImageSizeTakesEffectThroughSetConfig) {
   PipelineConfig small = config;
-  small.intrinsics.width = 320;
-  small.intrinsics.height = 240;
-  small.intrinsics.fx = small.intrinsics.fy = 265.0;
-  small.intrinsics.cx = 159.5;
-  small.intrinsics.cy = 119.5;
+  small.intrinsics = test::half_size_camera();
   pipeline.set_config(small);
   test::CraftedMarker m;
   m.centre_u_px = 160;
