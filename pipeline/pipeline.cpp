@@ -89,7 +89,8 @@ bool Pipeline::decode(const ImageView& frame, const MarkerPair& pair, MarkerObse
     ++counters_.unreadable_codes;
     return false;
   }
-  const double red_dot_px = layout.red_dot_n_m * std::hypot(m.north_u, m.north_v);
+  const double px_per_m = std::hypot(m.north_u, m.north_v);
+  const double red_dot_px = layout.red_dot_n_m * px_per_m;
   if (edge_spread_px(frame, m, true, layout) > config_.detector.max_blur_to_dot * red_dot_px) {
     ++counters_.blurred_markers;
     return false;
@@ -98,7 +99,6 @@ bool Pipeline::decode(const ImageView& frame, const MarkerPair& pair, MarkerObse
     ++counters_.ambiguous_codes;
     return false;
   }
-  const double px_per_m = std::hypot(m.north_u, m.north_v);
   if (code_i.code >= layout.codes() || code_j.code >= layout.codes() ||
       !dark_area_consistent(red, code_i.code, true, layout, px_per_m) ||
       !dark_area_consistent(green, code_j.code, false, layout, px_per_m)) {
@@ -131,7 +131,8 @@ bool Pipeline::decode(const ImageView& frame, const MarkerPair& pair, MarkerObse
               std::clamp(1.0f - static_cast<float>(pair.score) / 4.0f, 0.0f, 1.0f);
   // Points for positioning: the centroids. Area centroids of the full
   // rectangles (dots folded in) are unbiased under the affine view of a level
-  // camera, and thresholding shifts opposite edges alike.
+  // camera, thresholding shifts opposite edges alike, and fit_rectangles has
+  // already removed the shift that lens distortion gives them.
   o.point_count = 0;
   o.points[o.point_count++] = {0.0, 0.0, m.centre_u_px, m.centre_v_px};
   o.points[o.point_count++] = {layout.red_centre_e_m(), 0.0, red.cx, red.cy};
