@@ -2,6 +2,7 @@
 
 #include <fcntl.h>
 #include <grp.h>
+#include <pthread.h>
 #include <sys/file.h>
 #include <sys/mman.h>
 #include <sys/stat.h>
@@ -147,6 +148,8 @@ struct ShmPoseWriter::Impl {
   }
 
   void mark_stopped() {
+    // The last heartbeat then tells readers when the daemon stopped.
+    stop_heartbeat_thread();
     seg->header.state.store(static_cast<uint32_t>(WriterState::kStopped),
                             std::memory_order_release);
     beat();
@@ -156,6 +159,7 @@ struct ShmPoseWriter::Impl {
 
   void start_heartbeat_thread(int period_ms) {
     heartbeat_thread = std::thread([this, period_ms] {
+      ::pthread_setname_np(::pthread_self(), "shm-heartbeat");
       std::unique_lock<std::mutex> lock(heartbeat_mutex);
       while (!heartbeat_cv.wait_for(lock, std::chrono::milliseconds(period_ms),
                                     [this] { return heartbeat_stop; })) {
@@ -360,7 +364,7 @@ void ShmPoseWriter::publish(const PoseRecord& pose) {
   w.seg->latest.store(p);
   w.seg->ring[(p.seq - 1) % shm::kRingLength].store(p);
   h.latest_seq.store(p.seq, std::memory_order_release);
-  if (!w.running) {
+  if (!w.running && !w.stopped) {
     h.state.store(static_cast<uint32_t>(WriterState::kRunning), std::memory_order_release);
     w.running = true;
   }

@@ -55,7 +55,9 @@ class ShmPoseWriter {
   void update_status(const StatusRecord& status);
   // Refreshes the heartbeat (also done by publish() and the heartbeat thread).
   void heartbeat();
-  // State "stopped", wakes every blocked reader. Call on SIGTERM.
+  // State "stopped", wakes every blocked reader. Call on SIGTERM. Ends the
+  // heartbeat thread (waits for it, at most one period), so the last
+  // heartbeat is the stop time.
   void mark_stopped();
 
   const std::string& name() const;
