@@ -133,9 +133,12 @@ TEST(CaptureThread, DropsNewFramesWhileThePipelineHoldsTheWholeBudget) {
   ASSERT_TRUE(thread.start());
   Frame held[3];
   for (auto& h : held) ASSERT_TRUE(thread.acquire_latest(&h, 5000));
-  std::this_thread::sleep_for(std::chrono::milliseconds(30));
-  const CaptureStats during = thread.stats();
-  EXPECT_GT(during.drops, 0u);
+  // Frames keep arriving at 1 kHz; wait (bounded, for a loaded machine) until
+  // the thread has had to drop one.
+  for (int i = 0; i < 500 && thread.stats().drops == 0; ++i) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  }
+  EXPECT_GT(thread.stats().drops, 0u);
   for (auto& h : held) thread.release(h);
   Frame f;
   ASSERT_TRUE(thread.acquire_latest(&f, 5000));  // flows again after the release
