@@ -107,11 +107,12 @@ class PoseReader {
     reader_ = dds_create_reader(participant, topic_, qos, listener);
     dds_delete_qos(qos);
     if (listener != nullptr) dds_delete_listener(listener);
+    if (on_data != nullptr) return;  // the listener takes; nothing waits
     cond_ = dds_create_readcondition(reader_, DDS_ANY_STATE);
     waitset_ = dds_create_waitset(participant);
     dds_waitset_attach(waitset_, cond_, 0);
   }
-  bool ok() const { return topic_ > 0 && reader_ > 0 && cond_ > 0 && waitset_ > 0; }
+  bool ok() const { return topic_ > 0 && reader_ > 0; }
 
   // Takes one sample without blocking.
   static bool take_now(dds_entity_t reader, geometry_msgs_msg_dds__PoseWithCovarianceStamped_* msg,
