@@ -178,12 +178,22 @@ bool near_camera(const Projector& proj, int i, int j) {
          kDrawRadius_m - 0.3;
 }
 
-// Camera colour response in sRGB values: gamma, then saturation about the
+// Camera colour response in sRGB values: white balance, gamma, then saturation about the
 // luma, then additive Gaussian noise, rounded to 8 bits.
 cv::Mat apply_response(const cv::Mat& rgb, const XRenderOptions& options) {
-  if (options.gamma == 1.0 && options.saturation == 1.0 && options.noise_sigma == 0.0) return rgb;
+  const bool unit_gain = options.channel_gain == std::array<double, 3>{1.0, 1.0, 1.0};
+  if (unit_gain && options.gamma == 1.0 && options.saturation == 1.0 &&
+      options.noise_sigma == 0.0) {
+    return rgb;
+  }
   cv::Mat f;
   rgb.convertTo(f, CV_32FC3, 1.0 / 255.0);
+  if (!unit_gain) {
+    cv::multiply(
+        f, cv::Scalar(options.channel_gain[0], options.channel_gain[1], options.channel_gain[2]),
+        f);
+    cv::min(f, 1.0, f);
+  }
   if (options.gamma != 1.0) cv::pow(f, options.gamma, f);
   f *= 255.0;
   if (options.saturation != 1.0) {

@@ -34,13 +34,14 @@ struct XMount {
 };
 
 // How the frame departs from the ideal print: supersampling factor, a camera
-// colour response (gamma and saturation applied to sRGB values), additive
+// colour response (white balance, gamma and saturation applied to sRGB values), additive
 // Gaussian noise and light fixtures in some tiles.
 struct XRenderOptions {
   int supersample = 4;
   double gamma = 1.0;
   double saturation = 1.0;
   double noise_sigma = 0.0;
+  std::array<double, 3> channel_gain{1.0, 1.0, 1.0};  // R G B white balance
   bool light_fixtures = true;
   uint64_t seed = 1;
 };
