@@ -58,6 +58,8 @@ class DaemonLifecycle : public ::testing::Test {
 TEST_F(DaemonLifecycle, SendsReadyThenWatchdogPingsAtHalfTheInterval) {
   auto daemon = start();
   ASSERT_TRUE(notify_.wait_for("READY=1", kStartTimeoutMs)) << daemon->err();
+  // The first ping waits for the first processed frame.
+  ASSERT_TRUE(notify_.wait_for("WATCHDOG=1", kStartTimeoutMs)) << daemon->err();
   // Count pings over 2 s: one per 200 ms is 10; allow for a loaded machine.
   int pings = 0;
   const auto end = Clock::now() + milliseconds(2000);
