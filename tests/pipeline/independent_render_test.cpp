@@ -10,6 +10,7 @@
 #include <memory>
 #include <numbers>
 #include <opencv2/imgproc.hpp>
+#include <optional>
 #include <random>
 #include <string>
 #include <vector>
@@ -81,6 +82,8 @@ struct CaseFigures {
   double sum_left_mm = 0.0;     // pixel or axis convention shows as a bias
   std::vector<double> yaw_error_deg;
 
+  double bias_forward_mm() const { return valid ? sum_forward_mm / valid : 0.0; }
+  double bias_left_mm() const { return valid ? sum_left_mm / valid : 0.0; }
   double availability() const { return with_whole ? double(valid_with_whole) / with_whole : 1.0; }
   double both_share() const { return valid ? double(within_both) / valid : 0.0; }
 };
@@ -92,6 +95,9 @@ struct Case {
   XRenderOptions options;
   int frames = 60;
   bool yaw_near_pi = false;
+  // When set, frames are drawn with this camera while the pipeline is told
+  // `camera`: a deliberately bent convention, to show the check can see one.
+  std::optional<XCamera> render_camera;
 };
 
 CaseFigures run_case(const Case& c, uint64_t seed) {
@@ -110,7 +116,8 @@ CaseFigures run_case(const Case& c, uint64_t seed) {
     if (truth.yaw_rad <= -kPi) truth.yaw_rad += 2.0 * kPi;
     XRenderOptions options = c.options;
     options.seed = seed + static_cast<uint64_t>(k);
-    const cv::Mat rgb = testing::xcheck::render_rgb(c.camera, c.mount, truth, options);
+    const cv::Mat rgb =
+        testing::xcheck::render_rgb(c.render_camera.value_or(c.camera), c.mount, truth, options);
     pipeline.process(view_of(rgb, PixelFormat::kRgb24), PositioningMode::kAuto, result.get());
     const bool whole = !testing::xcheck::whole_markers(c.camera, c.mount, truth).empty();
     ++f.frames;
@@ -145,8 +152,8 @@ CaseFigures run_case(const Case& c, uint64_t seed) {
       "bias fwd %+.2f left %+.2f mm\n",
       c.name.c_str(), f.frames, f.availability(), f.both_share(), percentile(f.error_mm, 0.5),
       percentile(f.error_mm, 0.99), percentile(f.error_mm, 1.0), percentile(f.yaw_error_deg, 0.99),
-      percentile(f.yaw_error_deg, 1.0), f.gross, f.decoded, f.wrong_codes,
-      f.valid ? f.sum_forward_mm / f.valid : 0.0, f.valid ? f.sum_left_mm / f.valid : 0.0);
+      percentile(f.yaw_error_deg, 1.0), f.gross, f.decoded, f.wrong_codes, f.bias_forward_mm(),
+      f.bias_left_mm());
   return f;
 }
 
@@ -214,6 +221,88 @@ TEST(IndependentRender, CameraColourResponseAndNoiseMeetSpecAccuracy) {
   c.options.noise_sigma = 3.0;
   c.options.channel_gain = {1.06, 1.0, 0.88};  // warm light
   expect_spec_accuracy(c, 707);
+}
+
+TEST(IndependentRender, UnderexposedNoisyFramesMeetSpecAccuracy) {
+  Case c = default_case("dark");
+  c.options.channel_gain = {0.6, 0.6, 0.6};
+  c.options.noise_sigma = 2.0;
+  c.frames = 40;
+  expect_spec_accuracy(c, 901);
+}
+TEST(IndependentRender, OverexposedFramesMeetSpecAccuracy) {
+  Case c = default_case("bright");
+  c.options.channel_gain = {1.3, 1.3, 1.3};
+  c.frames = 40;
+  expect_spec_accuracy(c, 902);
+}
+TEST(IndependentRender, UnsupersampledHardEdgesMeetSpecAccuracy) {
+  Case c = default_case("aliased");
+  c.options.supersample = 1;
+  c.frames = 40;
+  expect_spec_accuracy(c, 903);
+}
+TEST(IndependentRender, DefocusAndStrongNoiseMeetSpecAccuracy) {
+  Case c = default_case("blur+noise");
+  c.options.blur_sigma_px = 1.2;
+  c.options.noise_sigma = 6.0;
+  c.frames = 40;
+  expect_spec_accuracy(c, 904);
+}
+TEST(IndependentRender, JpegRoundTripMeetsSpecAccuracy) {
+  Case c = default_case("jpeg");
+  c.options.jpeg_quality = 70;
+  c.frames = 40;
+  expect_spec_accuracy(c, 905);
+}
+
+TEST(IndependentRender, HarshExposureBlurNoiseJpegMeetSpecAccuracy) {
+  Case c = default_case("harsh");
+  c.options.channel_gain = {0.45, 0.45, 0.45};
+  c.options.blur_sigma_px = 2.0;
+  c.options.noise_sigma = 8.0;
+  c.options.jpeg_quality = 40;
+  c.frames = 40;
+  expect_spec_accuracy(c, 911);
+}
+TEST(IndependentRender, WideAngleDistortionMeetsSpecAccuracy) {
+  Case c = default_case("wide-lens");
+  c.camera.distortion = {-0.35, 0.12, 0.0, 0.0, -0.015};
+  c.frames = 40;
+  expect_spec_accuracy(c, 912);
+}
+TEST(IndependentRender, SmallDistortedNoisyCameraMeetsSpecAccuracy) {
+  Case c = default_case("320-dist-noise");
+  c.camera = XCamera{320, 240, 265.0, 265.0, 159.5, 119.5, {-0.2, 0.05, 0.001, -0.001, 0.0}};
+  c.options.supersample = 6;
+  c.options.noise_sigma = 4.0;
+  c.frames = 40;
+  expect_spec_accuracy(c, 913);
+}
+TEST(IndependentRender, OffCentrePrincipalPointAndUnequalFocalsMeetSpecAccuracy) {
+  Case c = default_case("off-centre-pp");
+  c.camera = XCamera{640, 480, 540.0, 520.0, 331.2, 228.7, {}};
+  c.frames = 40;
+  expect_spec_accuracy(c, 914);
+}
+
+// The check is only worth something if it sees a bent convention: reading
+// pixel (0, 0) as the top-left corner instead of the centre (SPEC §3) moves
+// the image by half a pixel on both axes, about 2 mm at 4 mm/px. Image down is
+// robot backward and image right is robot left, so the pose moves forward and
+// right.
+TEST(IndependentRender, HalfPixelConventionShiftShowsAsTwoMillimetreBias) {
+  Case c = default_case("half-px-bent");
+  XCamera corner_origin;
+  corner_origin.cx += 0.5;
+  corner_origin.cy += 0.5;
+  c.render_camera = corner_origin;
+  c.frames = 30;
+  const CaseFigures f = run_case(c, 915);
+  ASSERT_GT(f.valid, 0);
+  const double half_px_mm = 0.5 * (2.4384 - 0.3048) / 530.0 * 1000.0;
+  EXPECT_NEAR(f.bias_forward_mm(), half_px_mm, 0.6);
+  EXPECT_NEAR(f.bias_left_mm(), -half_px_mm, 0.6);
 }
 
 TEST(IndependentRender, EveryCodeIsDecodedAtItsMarker) {

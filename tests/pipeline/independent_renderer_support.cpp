@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <opencv2/calib3d.hpp>
+#include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
 // Everything below is read off SPEC.md, not off core/ or sim/:
@@ -203,6 +204,9 @@ cv::Mat apply_response(const cv::Mat& rgb, const XRenderOptions& options) {
     cv::merge(std::vector<cv::Mat>{luma, luma, luma}, luma3);
     f = luma3 + (f - luma3) * options.saturation;
   }
+  if (options.blur_sigma_px > 0.0) {
+    cv::GaussianBlur(f, f, cv::Size(), options.blur_sigma_px);
+  }
   if (options.noise_sigma > 0.0) {
     cv::Mat noise(f.size(), f.type());
     cv::RNG rng(options.seed);
@@ -229,7 +233,15 @@ cv::Mat render_rgb(const XCamera& camera, const XMount& mount, const XPose& robo
   }
   cv::Mat small;
   cv::resize(canvas, small, cv::Size(camera.width, camera.height), 0, 0, cv::INTER_AREA);
-  return apply_response(small, options);
+  cv::Mat out = apply_response(small, options);
+  if (options.jpeg_quality > 0) {
+    std::vector<uint8_t> jpeg;
+    cv::Mat bgr;
+    cv::cvtColor(out, bgr, cv::COLOR_RGB2BGR);
+    cv::imencode(".jpg", bgr, jpeg, {cv::IMWRITE_JPEG_QUALITY, options.jpeg_quality});
+    cv::cvtColor(cv::imdecode(jpeg, cv::IMREAD_COLOR), out, cv::COLOR_BGR2RGB);
+  }
+  return out;
 }
 
 std::vector<XVisibleMarker> whole_markers(const XCamera& camera, const XMount& mount,

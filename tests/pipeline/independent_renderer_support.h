@@ -42,6 +42,8 @@ struct XRenderOptions {
   double saturation = 1.0;
   double noise_sigma = 0.0;
   std::array<double, 3> channel_gain{1.0, 1.0, 1.0};  // R G B white balance
+  double blur_sigma_px = 0.0;                         // Gaussian defocus, before noise
+  int jpeg_quality = 0;  // > 0: JPEG round trip last, as an MJPEG camera
   bool light_fixtures = true;
   uint64_t seed = 1;
 };
