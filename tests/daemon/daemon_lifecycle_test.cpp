@@ -3,9 +3,11 @@
 // name and DDS off.
 #include <gtest/gtest.h>
 #include <signal.h>
+#include <unistd.h>
 
 #include <chrono>
 #include <fstream>
+#include <map>
 #include <sstream>
 #include <thread>
 
@@ -171,6 +173,29 @@ TEST_F(DaemonLifecycle, SighupSaysWhichKeysNeedARestart) {
   ASSERT_TRUE(daemon->wait(5000).has_value());
   EXPECT_NE(daemon->err().find("capture.fps changed but needs a restart"), std::string::npos)
       << daemon->err();
+}
+
+TEST_F(DaemonLifecycle, PublishesOnDdsAndDisposesOnSigterm) {
+  // DDS on loopback only, on a domain of its own (pid-derived, 100..199).
+  const std::string domain = std::to_string(100 + getpid() % 100);
+  // Built-in defaults (DDS on), not the tests' file, which turns DDS off.
+  const std::vector<std::string> args{"--source", "synthetic", "--shm",   shm_,
+                                      "--domain", domain,      "--robot", "testbot"};
+  const std::map<std::string, std::string> env{
+      {"NOTIFY_SOCKET", notify_.path()},
+      {"CYCLONEDDS_URI",
+       "<CycloneDDS><Domain><General><Interfaces><NetworkInterface name=\"lo\"/></Interfaces>"
+       "<AllowMulticast>false</AllowMulticast></General></Domain></CycloneDDS>"}};
+  DaemonProcess dds_daemon(args, env);
+  ASSERT_TRUE(notify_.wait_for("READY=1", kStartTimeoutMs)) << dds_daemon.err();
+  auto reader = ShmPoseReader::open_waiting(shm_, 5000);
+  ASSERT_TRUE(reader) << reader.error().message;
+  ASSERT_NE(next_pose(*reader, 0).seq, 0u) << dds_daemon.err();
+  dds_daemon.signal(SIGTERM);
+  auto exit = dds_daemon.wait(5000);
+  ASSERT_TRUE(exit.has_value());
+  EXPECT_EQ(exit->code, daemon::kExitOk) << dds_daemon.err();
+  EXPECT_NE(dds_daemon.err().find("topic rt/testbot/pose"), std::string::npos) << dds_daemon.err();
 }
 
 TEST_F(DaemonLifecycle, DurationEndsTheRunWithExitZero) {
