@@ -93,6 +93,9 @@ class CaptureThread {
   CaptureStats stats() const;
   RealtimeStatus realtime() const { return realtime_; }  // valid after start()
   const std::string& description() const { return description_; }
+  // The source's own camera model (a recording's recording.yaml, the
+  // simulator's camera); false for cameras. Valid after start().
+  bool camera_intrinsics(CameraIntrinsics* out) const { return source_->camera_intrinsics(out); }
   std::thread::native_handle_type native_handle() { return thread_.native_handle(); }
 
  private:

@@ -145,8 +145,15 @@ class Service {
   void loop();
   void reload();
   void shutdown();
+  // The configuration the pipeline runs with: the file's, with a replayed
+  // recording's own camera model in place of camera.*.
+  ServiceConfig running_config(ServiceConfig c) const {
+    if (replay_intrinsics_) c.pipeline.intrinsics = *replay_intrinsics_;
+    return c;
+  }
 
-  ServiceConfig config_;
+  ServiceConfig config_;  // as configured (file + command line); SIGHUP compares against it
+  std::optional<CameraIntrinsics> replay_intrinsics_;
   const DaemonOptions& options_;
   SignalChannel signals_;  // first: blocks the signals before any thread exists
   SystemdNotifier notifier_;
@@ -177,6 +184,16 @@ int Service::start() {
   if (auto r = capture_->start(); !r) {
     spdlog::error("frame source {}: {}", config_.capture.source, r.error().message);
     return kExitSourceFailure;
+  }
+  // A recording carries its own camera (recording.yaml), as `ceilposectl
+  // locate` uses it; a live camera's calibration is the configuration's job.
+  CameraIntrinsics recorded;
+  if (config_.capture.source.rfind("replay:", 0) == 0 && capture_->camera_intrinsics(&recorded)) {
+    replay_intrinsics_ = recorded;
+    spdlog::info(
+        "camera model from the recording: {}x{} px, fx {} fy {} cx {} cy {} (configuration's "
+        "camera.* not used for replay)",
+        recorded.width, recorded.height, recorded.fx, recorded.fy, recorded.cx, recorded.cy);
   }
   const capture::RealtimeStatus rt = capture_->realtime();
   spdlog::info(
@@ -230,8 +247,8 @@ int Service::start() {
   wopts.status_interval_ms = config_.watchdog.status_interval_ms;
   wopts.stall_after_frames = stall_after_frames_from_env();
   wopts.rt_priority = config_.capture.pipeline_rt_priority;
-  worker_ = std::make_unique<PipelineWorker>(config_, wopts, capture_.get(), &*shm_, dds,
-                                             &problems_, &progress_);
+  worker_ = std::make_unique<PipelineWorker>(running_config(config_), wopts, capture_.get(), &*shm_,
+                                             dds, &problems_, &progress_);
   worker_->start();
   if (wopts.rt_priority > 0 && !worker_->realtime())
     spdlog::warn(
@@ -358,7 +375,7 @@ void Service::reload() {
     live.positioning_mode = next->positioning_mode;
     live.logging = next->logging;
     if (!applied.empty()) {
-      worker_->reload(live, filter_changed);
+      worker_->reload(running_config(live), filter_changed);
       set_log_level(live.logging.level);
       spdlog::info("SIGHUP: applied {}", applied);
     }
