@@ -1,0 +1,68 @@
+// ceilposed on a recording whose camera differs from the configuration's: the
+// recording's own camera model (recording.yaml) must be the one localized with,
+// as `ceilposectl locate` does.
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <filesystem>
+#include <regex>
+#include <sstream>
+
+#include "daemon/exit_codes.h"
+#include "ipc/shm/shm_pose_writer.h"
+#include "recording/recording_writer.h"
+#include "sim/renderer.h"
+#include "sim/trajectory.h"
+#include "tests/daemon/daemon_process.h"
+
+namespace ceilpose::test {
+namespace {
+
+// A 320x240 recording of the simulator's trajectory, with ground truth.
+std::string write_small_recording(int frames) {
+  const std::string dir = testing::TempDir() + "ceilposed-replay-" + std::to_string(getpid());
+  std::filesystem::remove_all(dir);
+  sim::SceneOptions scene;
+  scene.intrinsics = sim::scaled_default_intrinsics(320);
+  RecordingCamera camera;
+  camera.intrinsics = scene.intrinsics;
+  camera.source = "synthetic, daemon_replay_test";
+  auto writer = RecordingWriter::create(dir, camera);
+  EXPECT_TRUE(writer.ok()) << writer.error().message;
+  sim::Renderer renderer(scene);
+  Image frame;
+  for (int i = 0; i < frames; ++i) {
+    const Pose2D truth = sim::trajectory_pose(scene.layout, i / 30.0);
+    renderer.render(truth, CameraMount{}, sim::Effects{}, static_cast<uint64_t>(i), &frame);
+    auto r = writer->append(frame.view(), 1'000'000'000 + i * 33'333'333LL, &truth);
+    EXPECT_TRUE(r.ok()) << r.error().message;
+  }
+  EXPECT_TRUE(writer->close().ok());
+  return dir;
+}
+
+TEST(DaemonReplay, LocalizesWithTheRecordingsCameraNotTheConfiguredOne) {
+  ASSERT_EQ(sim::scaled_default_intrinsics(320).width, 320);
+  const std::string dir = write_small_recording(30);
+  const std::string shm = unique_shm_name();
+  // The default configuration describes a 640x480 camera.
+  auto r = run_daemon({"--source", "replay:" + dir, "--shm", shm, "--no-dds", "--print-poses",
+                       "--duration", "2.5"});
+  (void)ShmPoseWriter::remove(shm);
+  std::filesystem::remove_all(dir);
+  ASSERT_EQ(r.exit.code, daemon::kExitOk) << r.err;
+  EXPECT_NE(r.err.find("camera model from the recording: 320x240"), std::string::npos) << r.err;
+  const std::regex err_mm(R"(err +([0-9.]+) mm)");
+  std::istringstream lines(r.out);
+  int checked = 0;
+  for (std::string line; std::getline(lines, line);) {
+    std::smatch m;
+    if (!std::regex_search(line, m, err_mm)) continue;
+    ++checked;
+    EXPECT_LT(std::stod(m[1].str()), 10.0) << line;
+  }
+  EXPECT_GT(checked, 3) << r.out;
+}
+
+}  // namespace
+}  // namespace ceilpose::test
