@@ -107,12 +107,14 @@ TEST(PipelineWorker, StatusRecordReachesReaders) {
   StatusRecord status{};
   bool seen = false;
   for (int i = 0; i < 300 && !seen; ++i) {
-    seen = reader->read_status(&status) == ReadResult::kOk && status.frames > 0;
+    // The first status interval may hold no processed frame (fps 0) on a slow
+    // (sanitized, loaded) machine; a later one must show the stream's rate.
+    seen = reader->read_status(&status) == ReadResult::kOk && status.frames > 0 && status.fps > 0.0;
     if (!seen) std::this_thread::sleep_for(std::chrono::milliseconds(10));
   }
   worker.stop();
-  ASSERT_TRUE(seen);
-  EXPECT_GT(status.fps, 0.0);
+  ASSERT_TRUE(seen) << "no status with frames and a positive fps within 3 s; last fps "
+                    << status.fps << ", frames " << status.frames;
   EXPECT_NE(std::string(status.source).find("synthetic"), std::string::npos) << status.source;
 }
 
