@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "core/clock.h"
+#include "core/json_text.h"
 #include "ctl/command_registry.h"
 #include "ipc/dds/dds_fleet_listener.h"
 
@@ -21,23 +22,6 @@ struct FleetArgs {
   std::vector<std::string> interfaces;
   std::vector<std::string> peers;
 };
-
-std::string json_string(const std::string& text) {
-  std::string out = "\"";
-  for (char c : text) {
-    if (c == '"' || c == '\\') {
-      out += '\\';
-      out += c;
-    } else if (static_cast<unsigned char>(c) < 0x20) {
-      char buf[8];
-      std::snprintf(buf, sizeof buf, "\\u%04x", c);
-      out += buf;
-    } else {
-      out += c;
-    }
-  }
-  return out + "\"";
-}
 
 std::string json_number(double v) {
   if (!std::isfinite(v)) return "null";
@@ -57,8 +41,8 @@ void print_json(const FleetArgs& args, const std::vector<FleetRobot>& robots, in
   for (const auto& r : robots) {
     if (!first) out += ",";
     first = false;
-    out += "{\"robot\":" + json_string(r.robot) + ",\"topic\":" + json_string(r.topic) +
-           ",\"type\":" + json_string(r.type_name) +
+    out += "{\"robot\":" + json_quote(r.robot) + ",\"topic\":" + json_quote(r.topic) +
+           ",\"type\":" + json_quote(r.type_name) +
            ",\"encoding\":" + (r.xcdr1 ? "\"XCDR1\"" : "\"XCDR2\"") +
            ",\"samples\":" + std::to_string(r.samples);
     if (r.samples > 0) {

@@ -11,6 +11,7 @@
 #include <string>
 
 #include "core/image.h"
+#include "core/json_text.h"
 #include "ctl/command_registry.h"
 #include "recording/recording_reader.h"
 
@@ -39,24 +40,6 @@ double thread_cpu_ms() {
   timespec ts{};
   clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
   return static_cast<double>(ts.tv_sec) * 1e3 + static_cast<double>(ts.tv_nsec) * 1e-6;
-}
-
-std::string escape_json(const std::string& text) {
-  std::string out;
-  for (const char c : text) {
-    if (c == '"' || c == '\\') {
-      out += '\\';
-      out += c;
-    } else if (static_cast<unsigned char>(c) < 0x20) {
-      char esc[8];
-      std::snprintf(esc, sizeof esc, "\\u%04x",
-                    static_cast<unsigned>(static_cast<unsigned char>(c)));
-      out += esc;
-    } else {
-      out += c;
-    }
-  }
-  return out;
 }
 
 // Progress goes to stderr: a rewritten line on a terminal, a line per tenth
@@ -154,7 +137,7 @@ std::string fixed(double v, int decimals) {
 
 void print_json(const RecordingReader& reader, const Summary& s) {
   const CameraIntrinsics& k = reader.camera().intrinsics;
-  std::string out = "{\"dir\":\"" + escape_json(reader.dir()) + "\",\"valid\":true";
+  std::string out = "{\"dir\":" + json_quote(reader.dir()) + ",\"valid\":true";
   auto field = [&out](const char* name, const std::string& value) {
     out += ",\"";
     out += name;
@@ -181,7 +164,7 @@ void print_json(const RecordingReader& reader, const Summary& s) {
   field("ground_truth_frames", std::to_string(s.ground_truth_frames));
   field("png_frames", std::to_string(s.png_frames));
   field("jpeg_frames", std::to_string(s.jpeg_frames));
-  field("source", "\"" + escape_json(reader.camera().source) + "\"");
+  field("source", json_quote(reader.camera().source));
   field("decoded", s.decoded ? "true" : "false");
   if (s.decoded) {
     field("decode_ms_per_frame", fixed(s.decode_ms_per_frame, 3));

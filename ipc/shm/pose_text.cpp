@@ -23,33 +23,6 @@ double degrees(double rad) { return rad * 180.0 / std::numbers::pi; }
 
 }  // namespace
 
-std::string json_quote(const std::string& text) {
-  std::string out = "\"";
-  for (const char c : text) {
-    switch (c) {
-      case '"':
-        out += "\\\"";
-        break;
-      case '\\':
-        out += "\\\\";
-        break;
-      case '\n':
-        out += "\\n";
-        break;
-      case '\t':
-        out += "\\t";
-        break;
-      default:
-        if (static_cast<unsigned char>(c) < 0x20) {
-          out += format("\\u%04x", static_cast<unsigned>(c));
-        } else {
-          out += c;
-        }
-    }
-  }
-  return out + "\"";
-}
-
 std::string pose_json(const PoseRecord& p, int64_t now_mono_ns, const std::string& extra) {
   const bool valid = pose_is_valid(p);
   std::string out = format("{\"seq\":%" PRIu64 ",\"valid\":%s", p.seq, valid ? "true" : "false");

@@ -4,6 +4,7 @@
 #include <cstdint>
 #include <string>
 
+#include "core/json_text.h"
 #include "ipc/shm/pose_record.h"
 
 namespace ceilpose {
@@ -16,8 +17,6 @@ namespace ceilpose {
 std::string pose_json(const PoseRecord& pose, int64_t now_mono_ns, const std::string& extra = "");
 // The same fields, all null, for "no pose" answers.
 std::string no_pose_json(const std::string& extra = "");
-// A JSON string literal with quotes and escapes.
-std::string json_quote(const std::string& text);
 
 // "seq 12  x 1.2345 m  y -0.5000 m  yaw  30.00 deg  mode lsq  markers 9  age 12.3 ms"
 std::string pose_line(const PoseRecord& pose, int64_t now_mono_ns);
