@@ -33,27 +33,12 @@ static int64_t monotonic_ns(void) {
   return (int64_t)ts.tv_sec * 1000000000 + ts.tv_nsec;
 }
 
-static const char* mode_name(uint8_t mode) {
-  switch (mode) {
-    case CEILPOSE_MODE_AUTO:
-      return "auto";
-    case CEILPOSE_MODE_AXES:
-      return "axes";
-    case CEILPOSE_MODE_BARYCENTRIC:
-      return "barycentric";
-    case CEILPOSE_MODE_LSQ:
-      return "lsq";
-    default:
-      return "unknown";
-  }
-}
-
 static void print_pose(const ceilpose_pose* p) {
   const double age_us = (double)(monotonic_ns() - p->publish_mono_ns) / 1000.0;
   if (p->flags & CEILPOSE_POSE_VALID) {
     printf("seq %8llu  x %8.4f m  y %8.4f m  yaw %7.2f deg  mode %s  markers %2u  age %.0f us\n",
            (unsigned long long)p->seq, p->x_m, p->y_m, p->yaw_rad * kDegreesPerRadian,
-           mode_name(p->mode), (unsigned)p->markers, age_us);
+           ceilpose_mode_name(p->mode), (unsigned)p->markers, age_us);
   } else {
     printf("seq %8llu  no fix\n", (unsigned long long)p->seq);
   }

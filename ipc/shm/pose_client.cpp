@@ -6,6 +6,7 @@
 #include <new>
 #include <string>
 
+#include "ipc/shm/pose_record.h"
 #include "ipc/shm/shm_pose_reader.h"
 
 struct ceilpose_client {
@@ -156,6 +157,8 @@ int ceilpose_client_read_recent(ceilpose_client* client, ceilpose_pose* out, uin
   *count = static_cast<uint32_t>(client->reader.read_recent(out, limit));
   return CEILPOSE_OK;
 }
+
+const char* ceilpose_mode_name(uint8_t mode) { return ceilpose::pose_mode_name(mode); }
 
 const char* ceilpose_strerror(int code) {
   switch (code) {

@@ -185,6 +185,10 @@ int ceilpose_client_read_recent(ceilpose_client* client, ceilpose_pose* out, uin
 /* Static English text for a return code. */
 const char* ceilpose_strerror(int code);
 
+/* Name of a positioning mode (enum ceilpose_mode) as SPEC §5 prints it:
+ * "auto", "axes", "barycentric", "lsq"; "unknown" otherwise. */
+const char* ceilpose_mode_name(uint8_t mode);
+
 /* Detailed message of the last failed call in this thread (names the segment,
  * its size and mode where relevant); "" if none. */
 const char* ceilpose_last_error_message(void);

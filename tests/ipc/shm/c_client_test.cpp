@@ -35,6 +35,14 @@ TEST_F(CClient, OpenOfMissingSegmentReturnsNotFoundWithMessageNamingIt) {
   EXPECT_NE(std::string(ceilpose_last_error_message()).find(name()), std::string::npos);
 }
 
+TEST(CClientModeName, NamesEveryModeAsSpecPrintsIt) {
+  EXPECT_STREQ(ceilpose_mode_name(CEILPOSE_MODE_AUTO), "auto");
+  EXPECT_STREQ(ceilpose_mode_name(CEILPOSE_MODE_AXES), "axes");
+  EXPECT_STREQ(ceilpose_mode_name(CEILPOSE_MODE_BARYCENTRIC), "barycentric");
+  EXPECT_STREQ(ceilpose_mode_name(CEILPOSE_MODE_LSQ), "lsq");
+  EXPECT_STREQ(ceilpose_mode_name(200), "unknown");
+}
+
 TEST_F(CClient, NullArgumentsAreInvalid) {
   EXPECT_EQ(ceilpose_client_open("/x", nullptr), CEILPOSE_ERR_INVALID_ARGUMENT);
   ceilpose_pose p;
