@@ -18,6 +18,7 @@
 #include "pipeline/pipeline.h"
 #include "pipeline/pipeline_config.h"
 #include "pipeline/temporal_filter.h"
+#include "recording/frame_prefetcher.h"
 #include "recording/recording_reader.h"
 
 namespace ceilpose::ctl {
@@ -27,6 +28,7 @@ struct ReplayArgs {
   std::string config_file;
   std::string mode_text;  // empty: the configuration's mode (SPEC default auto)
   bool filter = false;
+  int decode_threads = FramePrefetcher::default_threads();
 };
 
 // Adds --replay, --config, --filter and --mode to a sub-command.
@@ -39,6 +41,11 @@ inline void add_replay_options(CLI::App* cmd, ReplayArgs* args) {
                 "Apply the daemon's temporal filter (default: every frame solved on its own)");
   cmd->add_option("--mode", args->mode_text, "Positioning mode: auto | axes | barycentric | lsq")
       ->check(CLI::IsMember({"auto", "axes", "barycentric", "lsq"}));
+  cmd->add_option("--decode-threads", args->decode_threads,
+                  "Threads decoding frames ahead of localization (default: CPUs, at most 4); "
+                  "frames are still localized one at a time, in order")
+      ->check(CLI::Range(1, 64))
+      ->capture_default_str();
 }
 
 struct ReplaySetup {
@@ -92,11 +99,11 @@ inline int run_replay(const ReplayArgs& args, const char* command, const ReplayS
   Pipeline pipeline(setup.config);
   TemporalFilter filter(setup.config.filter);
   auto result = std::make_unique<FrameResult>();
-  Image frame;
+  FramePrefetcher frames(reader, args.decode_threads);
   const size_t total = reader.rows().size();
   const bool tty = ::isatty(STDERR_FILENO) == 1;
   for (size_t i = 0; i < total; ++i) {
-    auto loaded = reader.load_frame(i, &frame);
+    auto loaded = frames.next();
     if (!loaded.ok()) {
       if (tty) std::fputc('\n', stderr);
       std::fprintf(stderr, "ceilposectl %s: %s\n", command, loaded.error().message.c_str());
@@ -104,7 +111,7 @@ inline int run_replay(const ReplayArgs& args, const char* command, const ReplayS
     }
     const RecordingRow& row = reader.rows()[i];
     const int64_t start_ns = monotonic_ns();
-    pipeline.process(frame.view(), setup.mode, result.get());
+    pipeline.process((*loaded)->view(), setup.mode, result.get());
     ReplayFrame out;
     out.estimate =
         args.filter ? filter.update(result->estimate, row.timestamp_ns) : result->estimate;

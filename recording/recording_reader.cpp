@@ -24,11 +24,18 @@ namespace ceilpose {
 
 namespace fmt = recording_format;
 
-struct RecordingReader::Scratch {
+struct RecordingReader::DecodeBuffers {
   std::vector<uint8_t> file_bytes;  // the encoded frame, reused across frames
   FrameFileInfo info;
   cv::Mat decoded;  // decoder output for colour frames (BGR), reused
 };
+
+std::unique_ptr<RecordingReader::DecodeBuffers, RecordingReader::DecodeBuffersDeleter>
+RecordingReader::make_decode_buffers() {
+  return std::unique_ptr<DecodeBuffers, DecodeBuffersDeleter>(new DecodeBuffers());
+}
+
+void RecordingReader::DecodeBuffersDeleter::operator()(DecodeBuffers* b) const { delete b; }
 
 namespace {
 
@@ -280,7 +287,7 @@ Result<std::string> read_text(const std::string& path, const char* what) {
 
 }  // namespace
 
-RecordingReader::RecordingReader() : scratch_(std::make_unique<Scratch>()) {}
+RecordingReader::RecordingReader() : scratch_(make_decode_buffers()) {}
 RecordingReader::RecordingReader(RecordingReader&&) noexcept = default;
 RecordingReader& RecordingReader::operator=(RecordingReader&&) noexcept = default;
 RecordingReader::~RecordingReader() = default;
@@ -406,7 +413,7 @@ std::string RecordingReader::frame_context(size_t i) const {
   return dir_ + "/" + rows_[i].file + " (frames.csv:" + std::to_string(rows_[i].csv_line) + ")";
 }
 
-Result<void> RecordingReader::read_frame_file(size_t i) const {
+Result<void> RecordingReader::read_frame_file(size_t i, DecodeBuffers* buffers) const {
   if (i >= rows_.size()) {
     return make_error(dir_ + ": frame " + std::to_string(i) + " out of range (recording has " +
                       std::to_string(rows_.size()) + " frames)");
@@ -421,7 +428,7 @@ Result<void> RecordingReader::read_frame_file(size_t i) const {
     ::close(fd);
     return make_error(frame_context(i) + ": cannot stat frame file (" + std::strerror(err) + ")");
   }
-  auto& bytes = scratch_->file_bytes;
+  auto& bytes = buffers->file_bytes;
   bytes.resize(static_cast<size_t>(st.st_size));
   size_t done = 0;
   while (done < bytes.size()) {
@@ -448,17 +455,23 @@ Result<void> RecordingReader::read_frame_file(size_t i) const {
                       std::to_string(info->height) + ", recording.yaml says " +
                       std::to_string(k.width) + "x" + std::to_string(k.height));
   }
-  scratch_->info = *info;
+  buffers->info = *info;
   return {};
 }
 
-Result<void> RecordingReader::check_frame(size_t i) const { return read_frame_file(i); }
+Result<void> RecordingReader::check_frame(size_t i) const {
+  return read_frame_file(i, scratch_.get());
+}
 
 Result<void> RecordingReader::load_frame(size_t i, Image* out) const {
-  auto read = read_frame_file(i);
+  return load_frame(i, out, scratch_.get());
+}
+
+Result<void> RecordingReader::load_frame(size_t i, Image* out, DecodeBuffers* buffers) const {
+  auto read = read_frame_file(i, buffers);
   if (!read) return read;
-  const auto& bytes = scratch_->file_bytes;
-  const FrameFileInfo& info = scratch_->info;
+  const auto& bytes = buffers->file_bytes;
+  const FrameFileInfo& info = buffers->info;
   const cv::Mat encoded(1, static_cast<int>(bytes.size()), CV_8UC1,
                         const_cast<uint8_t*>(bytes.data()));
   // Grey frames decode straight into `out`; colour frames go through the
@@ -474,7 +487,7 @@ Result<void> RecordingReader::load_frame(size_t i, Image* out) const {
                           " data (decoder failed)");
       }
     } else {
-      cv::Mat& bgr = scratch_->decoded;
+      cv::Mat& bgr = buffers->decoded;
       const cv::Mat result = cv::imdecode(encoded, cv::IMREAD_UNCHANGED, &bgr);
       if (result.empty() || bgr.type() != CV_8UC3 || bgr.cols != info.width ||
           bgr.rows != info.height) {

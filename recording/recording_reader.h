@@ -9,8 +9,10 @@
 // are all empty (that frame has no ground truth), `distortion` omitted (none),
 // palette PNGs (decoded to RGB). Everything else that departs is an error.
 //
-// Thread safety: a reader may be used from one thread at a time (load_frame
-// reuses internal buffers so that replay does not allocate per frame).
+// Thread safety: load_frame(i, out) and check_frame reuse the reader's own
+// buffers (so that replay does not allocate per frame) and are for one thread
+// at a time; load_frame(i, out, buffers) may run on several threads at once,
+// each with its own DecodeBuffers (see FramePrefetcher).
 #include <cstddef>
 #include <cstdint>
 #include <memory>
@@ -59,6 +61,16 @@ class RecordingReader {
   // the frames.csv line. `out` keeps its buffer when the size does not change.
   Result<void> load_frame(size_t i, Image* out) const;
 
+  // The encoded bytes and decoder output that loading a frame reuses.
+  struct DecodeBuffers;
+  struct DecodeBuffersDeleter {
+    void operator()(DecodeBuffers* b) const;
+  };
+  static std::unique_ptr<DecodeBuffers, DecodeBuffersDeleter> make_decode_buffers();
+  // load_frame with caller-owned buffers: safe to call concurrently from
+  // threads that each pass their own.
+  Result<void> load_frame(size_t i, Image* out, DecodeBuffers* buffers) const;
+
   // Reads frame i's file and checks its structure (signature, complete chunk
   // or marker sequence, size, bit depth) without decoding the pixels.
   Result<void> check_frame(size_t i) const;
@@ -68,15 +80,14 @@ class RecordingReader {
 
  private:
   RecordingReader();
-  Result<void> read_frame_file(size_t i) const;
+  Result<void> read_frame_file(size_t i, DecodeBuffers* buffers) const;
 
   std::string dir_;
   RecordingCamera camera_;
   std::vector<RecordingRow> rows_;
   std::vector<std::string> frame_paths_;  // dir_ + "/" + file, so loading builds no strings
   bool has_ground_truth_columns_ = false;
-  struct Scratch;
-  std::unique_ptr<Scratch> scratch_;
+  std::unique_ptr<DecodeBuffers, DecodeBuffersDeleter> scratch_;
 };
 
 }  // namespace ceilpose

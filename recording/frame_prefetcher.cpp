@@ -1,0 +1,87 @@
+#include "recording/frame_prefetcher.h"
+
+#include <algorithm>
+#include <string>
+
+namespace ceilpose {
+
+namespace {
+// Beyond four threads PNG decoding outruns the pipeline on every machine we
+// target (a robot's SBC has four cores), and each thread holds a frame.
+constexpr int kMaxThreads = 4;
+}  // namespace
+
+int FramePrefetcher::default_threads() {
+  const unsigned cpus = std::thread::hardware_concurrency();
+  return std::clamp(static_cast<int>(cpus), 1, kMaxThreads);
+}
+
+FramePrefetcher::FramePrefetcher(const RecordingReader& reader, int threads, size_t first)
+    : reader_(reader),
+      end_(reader.rows().size()),
+      next_claim_(std::min(first, reader.rows().size())),
+      next_out_(next_claim_) {
+  threads = std::max(threads, 1);
+  // One slot per worker to decode into, one the consumer holds, one spare so
+  // that a worker never waits for the consumer to finish a frame.
+  slots_.resize(static_cast<size_t>(threads) + 2);
+  buffers_.reserve(static_cast<size_t>(threads));
+  workers_.reserve(static_cast<size_t>(threads));
+  for (int t = 0; t < threads; ++t) {
+    buffers_.push_back(RecordingReader::make_decode_buffers());
+    workers_.emplace_back(&FramePrefetcher::worker, this, buffers_.back().get());
+  }
+}
+
+FramePrefetcher::~FramePrefetcher() {
+  {
+    std::lock_guard lock(mutex_);
+    stop_ = true;
+  }
+  slot_free_.notify_all();
+  for (auto& w : workers_) w.join();
+}
+
+void FramePrefetcher::worker(RecordingReader::DecodeBuffers* buffers) {
+  std::unique_lock lock(mutex_);
+  for (;;) {
+    // Frames from the one the consumer still holds onward occupy slots; a
+    // worker may start a frame only when its slot is not among them.
+    const auto may_claim = [&] {
+      const size_t oldest = holding_ ? next_out_ - 1 : next_out_;
+      return next_claim_ < oldest + slots_.size();
+    };
+    slot_free_.wait(lock, [&] { return stop_ || next_claim_ >= end_ || may_claim(); });
+    if (stop_ || next_claim_ >= end_) return;
+    const size_t frame = next_claim_++;
+    Slot& slot = slots_[frame % slots_.size()];
+    slot.ready = false;
+    slot.frame = frame;
+    lock.unlock();
+    Result<void> status = reader_.load_frame(frame, &slot.image, buffers);
+    lock.lock();
+    slot.status = std::move(status);
+    slot.ready = true;
+    frame_ready_.notify_all();
+  }
+}
+
+Result<const Image*> FramePrefetcher::next() {
+  std::unique_lock lock(mutex_);
+  if (holding_) {
+    holding_ = false;
+    slot_free_.notify_one();
+  }
+  if (next_out_ >= end_) {
+    return make_error(reader_.dir() + ": read past the last frame (the recording has " +
+                      std::to_string(end_) + " frames)");
+  }
+  Slot& slot = slots_[next_out_ % slots_.size()];
+  frame_ready_.wait(lock, [&] { return slot.ready && slot.frame == next_out_; });
+  ++next_out_;
+  holding_ = true;
+  if (!slot.status) return slot.status.error();
+  return &slot.image;
+}
+
+}  // namespace ceilpose
