@@ -7,10 +7,11 @@
 #include <string>
 #include <thread>
 
+#include "core/clock.h"
 #include "ipc/dds/dds_fleet_listener.h"
 #include "ipc/dds/dds_pose_publisher.h"
-#include "tests/ipc/dds/child_process.h"
 #include "tests/ipc/dds/dds_test_env.h"
+#include "tests/support/child_process.h"
 
 namespace ceilpose {
 namespace {

@@ -5,8 +5,8 @@
 
 #include <string>
 
-#include "tests/ipc/dds/child_process.h"
 #include "tests/ipc/dds/dds_test_env.h"
+#include "tests/support/child_process.h"
 
 namespace ceilpose {
 namespace {

@@ -10,10 +10,11 @@
 #include <string>
 #include <vector>
 
+#include "core/clock.h"
 #include "ipc/dds/dds_messages.h"
 #include "ipc/dds/dds_participant.h"
-#include "tests/ipc/dds/child_process.h"
 #include "tests/ipc/dds/dds_test_env.h"
+#include "tests/support/child_process.h"
 
 namespace ceilpose {
 namespace {
