@@ -11,8 +11,9 @@ struct CommandOutput {
   std::string err;
 };
 
-// Runs ceilposectl with `args`, output captured in files under `scratch_dir`.
-// Kills it and fails the current test after `timeout_ms`.
+// Runs ceilposectl with `args` and captures its stdout and stderr. Kills it
+// and fails the current test after `timeout_ms`. `scratch_dir` is unused
+// (output comes back through pipes); it stays until the callers drop it.
 CommandOutput run_ceilposectl(const std::vector<std::string>& args, const std::string& scratch_dir,
                               int timeout_ms = 60'000);
 
