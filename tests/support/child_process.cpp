@@ -25,6 +25,7 @@ constexpr int kExitPollMs = 10;
 // One drain reads at most this much, so a child that writes without pause
 // cannot keep the caller reading past its deadline.
 constexpr size_t kMaxReadPerDrainBytes = size_t{1} << 20;
+constexpr int kPipeBytes = 1 << 20;
 
 int ms_until(Clock::time_point deadline) {
   const auto left = std::chrono::duration_cast<std::chrono::milliseconds>(deadline - Clock::now());
@@ -67,6 +68,10 @@ std::vector<char*> c_strings(std::vector<std::string>& text) {
 bool make_pipe(int fds[2]) {
   if (pipe2(fds, O_CLOEXEC) != 0) return false;
   fcntl(fds[0], F_SETFL, fcntl(fds[0], F_GETFL) | O_NONBLOCK);
+  // Output is read only while the test calls in here; a larger pipe (best
+  // effort, 1 MiB is the unprivileged limit) lets a chatty daemon log on
+  // while the test waits on something else.
+  fcntl(fds[1], F_SETPIPE_SZ, kPipeBytes);
   return true;
 }
 

@@ -67,8 +67,9 @@ TEST(ChildProcess, ReadUntilStopsWhenTheChildEndsWithoutTheNeedle) {
 TEST(ChildProcess, KeepsOutputUpToTheBoundAndNeverBlocksTheChild) {
   ChildOptions options;
   options.max_output_bytes = 1000;
-  // 1 MB: far more than a pipe holds, so the child ends only if it is read.
-  ChildProcess child({"/usr/bin/head", "-c", "1000000", "/dev/zero"}, options);
+  // 4 MB: more than the pipe holds (1 MiB at most), so the child ends only
+  // if it is read.
+  ChildProcess child({"/usr/bin/head", "-c", "4000000", "/dev/zero"}, options);
   EXPECT_EQ(child.wait_exit(kTimeoutMs), 0);
   EXPECT_EQ(child.output().size(), 1000u);
 }
