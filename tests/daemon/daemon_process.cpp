@@ -1,24 +1,20 @@
 #include "tests/daemon/daemon_process.h"
 
-#include <fcntl.h>
 #include <gtest/gtest.h>
 #include <poll.h>
-#include <signal.h>
-#include <spawn.h>
 #include <sys/socket.h>
 #include <sys/stat.h>
 #include <sys/un.h>
-#include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <atomic>
+#include <cerrno>
 #include <chrono>
 #include <cstring>
 #include <fstream>
 #include <sstream>
-#include <thread>
-
-extern char** environ;
+#include <stdexcept>
 
 namespace ceilpose::test {
 namespace {
@@ -30,11 +26,19 @@ std::string temp_path(const std::string& stem) {
          std::to_string(g_counter.fetch_add(1)) + "-" + stem;
 }
 
-std::string read_file(const std::string& path) {
-  std::ifstream in(path);
-  std::ostringstream s;
-  s << in.rdbuf();
-  return s.str();
+ChildOptions daemon_options(const std::map<std::string, std::string>& env) {
+  ChildOptions options;
+  options.capture_stderr = true;
+  // A test never inherits the systemd protocol from whoever runs ctest.
+  options.env = {{"NOTIFY_SOCKET", ""}, {"WATCHDOG_USEC", ""}, {"WATCHDOG_PID", ""}};
+  for (const auto& [name, value] : env) options.env[name] = value;
+  return options;
+}
+
+std::vector<std::string> daemon_argv(const std::vector<std::string>& args) {
+  std::vector<std::string> argv{CEILPOSED_PATH};
+  argv.insert(argv.end(), args.begin(), args.end());
+  return argv;
 }
 
 }  // namespace
@@ -82,101 +86,23 @@ bool NotifySocket::wait_for(const std::string& line, int timeout_ms) {
 }
 
 DaemonProcess::DaemonProcess(const std::vector<std::string>& args,
-                             const std::map<std::string, std::string>& env) {
-  out_path_ = temp_path("stdout");
-  err_path_ = temp_path("stderr");
-  std::vector<std::string> argv_s{CEILPOSED_PATH};
-  argv_s.insert(argv_s.end(), args.begin(), args.end());
-  std::vector<char*> argv;
-  for (auto& a : argv_s) argv.push_back(a.data());
-  argv.push_back(nullptr);
-
-  std::map<std::string, std::string> merged;
-  for (char** e = environ; *e != nullptr; ++e) {
-    const std::string kv(*e);
-    const size_t eq = kv.find('=');
-    if (eq != std::string::npos) merged[kv.substr(0, eq)] = kv.substr(eq + 1);
-  }
-  // A test never inherits the systemd protocol from whoever runs ctest.
-  merged.erase("NOTIFY_SOCKET");
-  merged.erase("WATCHDOG_USEC");
-  merged.erase("WATCHDOG_PID");
-  for (const auto& [k, v] : env) {
-    if (v.empty()) {
-      merged.erase(k);
-    } else {
-      merged[k] = v;
-    }
-  }
-  std::vector<std::string> env_s;
-  for (const auto& [k, v] : merged) env_s.push_back(k + "=" + v);
-  std::vector<char*> envp;
-  for (auto& e : env_s) envp.push_back(e.data());
-  envp.push_back(nullptr);
-
-  posix_spawn_file_actions_t fa;
-  posix_spawn_file_actions_init(&fa);
-  posix_spawn_file_actions_addopen(&fa, STDIN_FILENO, "/dev/null", O_RDONLY, 0);
-  posix_spawn_file_actions_addopen(&fa, STDOUT_FILENO, out_path_.c_str(),
-                                   O_WRONLY | O_CREAT | O_TRUNC, 0644);
-  posix_spawn_file_actions_addopen(&fa, STDERR_FILENO, err_path_.c_str(),
-                                   O_WRONLY | O_CREAT | O_TRUNC, 0644);
-  const int r = posix_spawn(&pid_, argv[0], &fa, nullptr, argv.data(), envp.data());
-  posix_spawn_file_actions_destroy(&fa);
-  if (r != 0) throw std::runtime_error(std::string("posix_spawn ceilposed: ") + std::strerror(r));
+                             const std::map<std::string, std::string>& env)
+    : ChildProcess(daemon_argv(args), daemon_options(env)) {
+  if (!started()) throw std::runtime_error(start_error());
 }
-
-DaemonProcess::~DaemonProcess() {
-  if (running()) {
-    kill(pid_, SIGKILL);
-    wait(5000);
-  }
-  unlink(out_path_.c_str());
-  unlink(err_path_.c_str());
-}
-
-void DaemonProcess::signal(int sig) { kill(pid_, sig); }
-
-bool DaemonProcess::running() {
-  if (exit_) return false;
-  return !wait(0).has_value();
-}
-
-std::optional<Exit> DaemonProcess::wait(int timeout_ms) {
-  if (exit_) return exit_;
-  const auto deadline = std::chrono::steady_clock::now() + std::chrono::milliseconds(timeout_ms);
-  for (;;) {
-    int status = 0;
-    const pid_t r = waitpid(pid_, &status, WNOHANG);
-    if (r == pid_) {
-      Exit e;
-      e.exited = WIFEXITED(status);
-      e.code = e.exited ? WEXITSTATUS(status) : -1;
-      e.signal = WIFSIGNALED(status) ? WTERMSIG(status) : 0;
-      exit_ = e;
-      return exit_;
-    }
-    if (std::chrono::steady_clock::now() >= deadline) return std::nullopt;
-    std::this_thread::sleep_for(std::chrono::milliseconds(5));
-  }
-}
-
-std::string DaemonProcess::out() const { return read_file(out_path_); }
-std::string DaemonProcess::err() const { return read_file(err_path_); }
 
 RunResult run_daemon(const std::vector<std::string>& args, int timeout_ms,
                      const std::map<std::string, std::string>& env) {
   DaemonProcess p(args, env);
   RunResult r;
-  auto e = p.wait(timeout_ms);
-  if (!e) {
-    p.signal(SIGKILL);
-    e = p.wait(5000);
+  if (const auto e = p.wait(timeout_ms)) {
+    r.exit = *e;
+  } else {
+    r.exit = p.kill();
     ADD_FAILURE() << "ceilposed did not end within " << timeout_ms << " ms";
   }
-  r.exit = e.value_or(Exit{});
-  r.out = p.out();
-  r.err = p.err();
+  r.out = p.output();
+  r.err = p.error_output();
   return r;
 }
 

@@ -1,14 +1,14 @@
 #pragma once
 // Test support: ceilposed as a child process, with a NOTIFY_SOCKET the test
-// owns (an AF_UNIX datagram socket, as systemd's), stdout and stderr captured
-// to files, and bounded waits everywhere.
-#include <sys/types.h>
-
+// owns (an AF_UNIX datagram socket, as systemd's), stdout and stderr captured,
+// and bounded waits everywhere.
 #include <cstdint>
 #include <map>
 #include <optional>
 #include <string>
 #include <vector>
+
+#include "tests/support/child_process.h"
 
 namespace ceilpose::test {
 
@@ -31,40 +31,22 @@ class NotifySocket {
   std::string path_;
 };
 
-struct Exit {
-  bool exited = false;  // false: killed by a signal (or still running at timeout)
-  int code = -1;        // exit status when exited
-  int signal = 0;
-};
-
-class DaemonProcess {
+// ceilposed as a child process, stdout and stderr captured. The systemd
+// protocol variables of whoever runs ctest are not passed on unless `env`
+// sets them.
+class DaemonProcess : public ChildProcess {
  public:
   // Starts ceilposed with `args`; `env` adds to (or, with an empty value,
-  // removes from) the test's environment.
+  // removes from) the test's environment. Throws when it cannot start.
   DaemonProcess(const std::vector<std::string>& args,
                 const std::map<std::string, std::string>& env);
-  ~DaemonProcess();  // SIGKILLs a child that is still running
-  DaemonProcess(const DaemonProcess&) = delete;
-  DaemonProcess& operator=(const DaemonProcess&) = delete;
-
-  pid_t pid() const { return pid_; }
-  void signal(int sig);
-  bool running();
-  // Waits up to timeout_ms for the child to end; `exited`/`signal` unset on timeout.
-  std::optional<Exit> wait(int timeout_ms);
-  std::string out() const;  // captured stdout so far
-  std::string err() const;  // captured stderr so far
-
- private:
-  pid_t pid_ = -1;
-  std::optional<Exit> exit_;
-  std::string out_path_;
-  std::string err_path_;
+  // What the daemon logged so far: the tests' failure messages.
+  const std::string& err() { return error_output(); }
 };
 
 // Runs ceilposed to completion (bounded) and returns exit + outputs.
 struct RunResult {
-  Exit exit;
+  ExitStatus exit;
   std::string out;
   std::string err;
 };
