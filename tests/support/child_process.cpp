@@ -171,9 +171,17 @@ ExitStatus ChildProcess::kill() {
 }
 
 const std::string& ChildProcess::read_until(const std::string& needle, int timeout_ms) {
+  return read_until(out_, needle, timeout_ms);
+}
+
+const std::string& ChildProcess::read_error_until(const std::string& needle, int timeout_ms) {
+  return read_until(err_, needle, timeout_ms);
+}
+
+const std::string& ChildProcess::read_until(Stream& s, const std::string& needle, int timeout_ms) {
   const auto deadline = deadline_after(timeout_ms);
-  read_available(out_);
-  while (out_.text.find(needle) == std::string::npos && out_.fd >= 0) {
+  read_available(s);
+  while (s.text.find(needle) == std::string::npos && s.fd >= 0) {
     // Once the child has ended, what it wrote is all in the pipe already: a
     // grandchild holding the pipe open must not keep this waiting for EOF.
     if (reap(false)) break;
@@ -181,7 +189,7 @@ const std::string& ChildProcess::read_until(const std::string& needle, int timeo
     if (left_ms <= 0) break;
     pump(left_ms);
   }
-  return out_.text;
+  return s.text;
 }
 
 const std::string& ChildProcess::output() {
@@ -243,6 +251,26 @@ bool ChildProcess::reap(bool block) {
   read_available(out_);
   read_available(err_);
   return true;
+}
+
+RunOutput run_to_end(const std::vector<std::string>& argv, int timeout_ms) {
+  ChildOptions options;
+  options.capture_stderr = true;
+  ChildProcess child(argv, options);
+  RunOutput result;
+  if (!child.started()) {
+    result.failure = child.start_error();
+    return result;
+  }
+  if (const auto e = child.wait(timeout_ms)) {
+    result.exit_code = e->code;
+  } else {
+    child.kill();
+    result.failure = argv[0] + " still running after " + std::to_string(timeout_ms) + " ms, killed";
+  }
+  result.out = child.output();
+  result.err = child.error_output();
+  return result;
 }
 
 }  // namespace ceilpose::test

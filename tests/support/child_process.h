@@ -61,6 +61,8 @@ class ChildProcess {
 
   // Reads stdout until `needle` appears, EOF or timeout; returns all of it so far.
   const std::string& read_until(const std::string& needle, int timeout_ms);
+  // The same for stderr; returns at once with "" unless capture_stderr.
+  const std::string& read_error_until(const std::string& needle, int timeout_ms);
   // What the child wrote so far, read without blocking.
   const std::string& output();
   const std::string& error_output();  // empty unless capture_stderr
@@ -73,6 +75,7 @@ class ChildProcess {
   // Reads what the pipes hold, first waiting up to timeout_ms for data or
   // for the exit.
   void pump(int timeout_ms);
+  const std::string& read_until(Stream& s, const std::string& needle, int timeout_ms);
   void read_available(Stream& s);
   // Reaps the child if it has ended; true once reaped.
   bool reap(bool block);
@@ -85,5 +88,19 @@ class ChildProcess {
   std::optional<ExitStatus> exit_;
   std::string start_error_;
 };
+
+// What a program run to its end wrote, and how it ended.
+struct RunOutput {
+  int exit_code = -1;  // -1: killed at the deadline, ended by a signal or never started
+  std::string out;
+  std::string err;
+  // Why it could not start or had to be killed ("cannot start ...", "...
+  // still running after N ms, killed"); empty otherwise.
+  std::string failure;
+};
+
+// Runs `argv` with stdout and stderr captured apart until it ends; kills it
+// after timeout_ms.
+RunOutput run_to_end(const std::vector<std::string>& argv, int timeout_ms);
 
 }  // namespace ceilpose::test

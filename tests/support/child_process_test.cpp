@@ -74,6 +74,18 @@ TEST(ChildProcess, KeepsOutputUpToTheBoundAndNeverBlocksTheChild) {
   EXPECT_EQ(child.output().size(), 1000u);
 }
 
+TEST(ChildProcess, ReadErrorUntilReturnsWhileTheChildRuns) {
+  ChildProcess child(sh("echo waiting >&2; exec sleep 60"), capturing_stderr());
+  EXPECT_EQ(child.read_error_until("waiting", kTimeoutMs), "waiting\n");
+  EXPECT_TRUE(child.running());
+  EXPECT_EQ(child.output(), "");
+}
+
+TEST(ChildProcess, ReadErrorUntilIsEmptyWhenStderrIsNotCaptured) {
+  ChildProcess child(sh("echo waiting >&2; exec sleep 60"));
+  EXPECT_EQ(child.read_error_until("waiting", kTimeoutMs), "");
+}
+
 TEST(ChildProcess, WaitTimesOutAndLeavesTheChildRunning) {
   ChildProcess child(sh("exec sleep 60"));
   EXPECT_FALSE(child.wait(10).has_value());
@@ -149,6 +161,27 @@ TEST(ChildProcess, DestructorKillsAndReapsARunningChild) {
   errno = 0;
   EXPECT_EQ(waitpid(pid, nullptr, WNOHANG), -1);
   EXPECT_EQ(errno, ECHILD);
+}
+
+TEST(RunToEnd, ReturnsTheCodeAndBothStreams) {
+  const RunOutput r = run_to_end(sh("echo to-out; echo to-err >&2; exit 4"), kTimeoutMs);
+  EXPECT_EQ(r.exit_code, 4);
+  EXPECT_EQ(r.out, "to-out\n");
+  EXPECT_EQ(r.err, "to-err\n");
+  EXPECT_EQ(r.failure, "");
+}
+
+TEST(RunToEnd, KillsAtTheDeadlineAndKeepsWhatWasWritten) {
+  const RunOutput r = run_to_end(sh("echo started; exec sleep 60"), 200);
+  EXPECT_EQ(r.exit_code, -1);
+  EXPECT_EQ(r.out, "started\n");
+  EXPECT_NE(r.failure.find("still running after 200 ms"), std::string::npos) << r.failure;
+}
+
+TEST(RunToEnd, SaysWhyAProgramCannotStart) {
+  const RunOutput r = run_to_end({"/nonexistent/program"}, kTimeoutMs);
+  EXPECT_EQ(r.exit_code, -1);
+  EXPECT_NE(r.failure.find("/nonexistent/program"), std::string::npos) << r.failure;
 }
 
 }  // namespace
