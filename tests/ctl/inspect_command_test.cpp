@@ -19,7 +19,7 @@ class InspectCommand : public ::testing::Test {
 };
 
 TEST_F(InspectCommand, SummarisesAValidRecording) {
-  const CommandOutput r = run_ceilposectl({"inspect", dir_}, tmp_.path());
+  const CommandOutput r = run_ceilposectl({"inspect", dir_});
   EXPECT_EQ(r.exit_code, 0) << r.err;
   // 5 frames 16.666667 ms apart: 4 intervals, 0.0667 s, 60 fps.
   expect_mentions(r.out,
@@ -28,7 +28,7 @@ TEST_F(InspectCommand, SummarisesAValidRecording) {
 }
 
 TEST_F(InspectCommand, JsonSummaryHasFramesDurationFpsSizeAndGroundTruth) {
-  const CommandOutput r = run_ceilposectl({"inspect", dir_, "--json"}, tmp_.path());
+  const CommandOutput r = run_ceilposectl({"inspect", dir_, "--json"});
   EXPECT_EQ(r.exit_code, 0) << r.err;
   expect_mentions(r.out, {"\"valid\":true", "\"frames\":5", "\"duration_s\":0.066667",
                           "\"fps\":60.000", "\"size\":\"64x48\"", "\"width\":64", "\"height\":48",
@@ -36,14 +36,14 @@ TEST_F(InspectCommand, JsonSummaryHasFramesDurationFpsSizeAndGroundTruth) {
 }
 
 TEST_F(InspectCommand, DecodeReportsProgressOnStderrAndDecodeTime) {
-  const CommandOutput r = run_ceilposectl({"inspect", dir_, "--json", "--decode"}, tmp_.path());
+  const CommandOutput r = run_ceilposectl({"inspect", dir_, "--json", "--decode"});
   EXPECT_EQ(r.exit_code, 0) << r.err;
   expect_mentions(r.err, {"5/5"});
   expect_mentions(r.out, {"\"decoded\":true", "\"decode_ms_per_frame\":"});
 }
 
 TEST_F(InspectCommand, MissingDirectoryArgumentIsAUsageError) {
-  const CommandOutput r = run_ceilposectl({"inspect"}, tmp_.path());
+  const CommandOutput r = run_ceilposectl({"inspect"});
   EXPECT_EQ(r.exit_code, kExitUsage);
 }
 
@@ -65,19 +65,19 @@ TEST_P(MalformedRecordingCommand, InspectExitsWithBadInputAndNamesTheDefect) {
   const std::string d = malformed_recording(mc, tmp_);
   std::vector<std::string> args{"inspect", d};
   if (mc.found_by == FoundBy::kDecode) args.push_back("--decode");
-  const CommandOutput r = run_ceilposectl(args, tmp_.path());
+  const CommandOutput r = run_ceilposectl(args);
   EXPECT_EQ(r.exit_code, kExitBadInput) << r.err;
   expect_mentions(r.err, mc.expected);
   EXPECT_EQ(r.out, "") << "no summary for a malformed recording";
 }
 
 TEST_P(MalformedRecordingCommand, LocateReplayExitsNonZeroAndNamesTheDefect) {
-  if (!has_subcommand("locate", tmp_.path())) {
+  if (!has_subcommand("locate")) {
     GTEST_SKIP() << "this ceilposectl has no `locate` sub-command yet";
   }
   const MalformedCase& mc = GetParam();
   const std::string d = malformed_recording(mc, tmp_);
-  const CommandOutput r = run_ceilposectl({"locate", "--replay", d}, tmp_.path());
+  const CommandOutput r = run_ceilposectl({"locate", "--replay", d});
   EXPECT_NE(r.exit_code, 0) << r.err;
   expect_mentions(r.err, mc.expected);
 }

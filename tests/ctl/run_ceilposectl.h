@@ -3,21 +3,17 @@
 #include <string>
 #include <vector>
 
+#include "tests/support/child_process.h"
+
 namespace ceilpose::test {
 
-struct CommandOutput {
-  int exit_code = -1;  // -1 when the process did not exit normally
-  std::string out;
-  std::string err;
-};
+using CommandOutput = RunOutput;
 
 // Runs ceilposectl with `args` and captures its stdout and stderr. Kills it
-// and fails the current test after `timeout_ms`. `scratch_dir` is unused
-// (output comes back through pipes); it stays until the callers drop it.
-CommandOutput run_ceilposectl(const std::vector<std::string>& args, const std::string& scratch_dir,
-                              int timeout_ms = 60'000);
+// and fails the current test after `timeout_ms`.
+CommandOutput run_ceilposectl(const std::vector<std::string>& args, int timeout_ms = 60'000);
 
 // True when this ceilposectl build has the sub-command.
-bool has_subcommand(const std::string& name, const std::string& scratch_dir);
+bool has_subcommand(const std::string& name);
 
 }  // namespace ceilpose::test
