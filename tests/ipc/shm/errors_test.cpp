@@ -18,7 +18,7 @@ namespace ceilpose {
 namespace {
 
 using shm::ShmErrc;
-using test::ChildProcess;
+using test::ForkedChild;
 
 class ShmErrors : public test::ShmFixture {};
 
@@ -127,7 +127,7 @@ TEST_F(ShmErrors, UnprivilegedReaderIsRefusedWithPermissionErrorNamingMode) {
   ASSERT_NO_FATAL_FAILURE(start());
   if (::geteuid() != 0) GTEST_SKIP() << "needs root to switch to uid " << kNobody;
   constexpr int kSetuidFailed = 77;
-  ChildProcess child([&](ChildProcess&) {
+  ForkedChild child([&](ForkedChild&) {
     if (::setgroups(0, nullptr) != 0 || ::setgid(kNobody) != 0 || ::setuid(kNobody) != 0) {
       return kSetuidFailed;
     }

@@ -14,7 +14,7 @@ namespace ceilpose {
 namespace {
 
 using test::check_pose;
-using test::ChildProcess;
+using test::ForkedChild;
 
 class ShmFutex : public test::ShmFixture {};
 
@@ -75,7 +75,7 @@ TEST_F(ShmFutex, PublishWithBlockedWaiterMakesWakeSyscall) {
 }
 
 TEST_F(ShmFutex, ReaderProcessIsWokenByWriterProcess) {
-  ChildProcess child(test::writer_child(name(), [](ShmPoseWriter& writer, ChildProcess& self) {
+  ForkedChild child(test::writer_child(name(), [](ShmPoseWriter& writer, ForkedChild& self) {
     self.notify_parent();
     if (!self.wait_for_parent(20'000)) return 11;
     std::this_thread::sleep_for(std::chrono::milliseconds(50));

@@ -17,7 +17,7 @@ namespace {
 
 using shm::ShmErrc;
 using test::check_pose;
-using test::ChildProcess;
+using test::ForkedChild;
 
 class ShmLifecycle : public test::ShmFixture {};
 
@@ -25,8 +25,8 @@ constexpr int kHandshakeMs = 20'000;
 
 // A child that creates a writer, publishes `poses` poses, tells the parent
 // and then waits (to be killed, or released to exit cleanly).
-ChildProcess::Body publishing_writer(const std::string& name, uint64_t poses) {
-  return test::writer_child(name, [poses](ShmPoseWriter& writer, ChildProcess& self) {
+ForkedChild::Body publishing_writer(const std::string& name, uint64_t poses) {
+  return test::writer_child(name, [poses](ShmPoseWriter& writer, ForkedChild& self) {
     for (uint64_t k = 1; k <= poses; ++k) writer.publish(check_pose(k));
     self.notify_parent();
     self.wait_for_parent(60'000);
@@ -44,7 +44,7 @@ TEST_F(ShmLifecycle, OpenBeforeWriterStartsReportsNotFound) {
 
 TEST_F(ShmLifecycle, ReaderWaitingBeforeWriterStartsAttachesWhenItAppears) {
   std::thread late_writer_starter;
-  ChildProcess child([&](ChildProcess& self) {
+  ForkedChild child([&](ForkedChild& self) {
     if (!self.wait_for_parent(kHandshakeMs)) return 11;
     return publishing_writer(name(), 3)(self);
   });
@@ -148,7 +148,7 @@ TEST_F(ShmLifecycle, SecondWriterOnLiveSegmentIsRefusedNamingThePid) {
 }
 
 TEST_F(ShmLifecycle, SecondWriterInAnotherProcessIsRefused) {
-  ChildProcess child(publishing_writer(name(), 1));
+  ForkedChild child(publishing_writer(name(), 1));
   ASSERT_TRUE(child.wait_for_child(kHandshakeMs));
   ShmOptions options;
   options.name = name();
@@ -161,7 +161,7 @@ TEST_F(ShmLifecycle, SecondWriterInAnotherProcessIsRefused) {
 }
 
 TEST_F(ShmLifecycle, KilledWriterIsReportedDead) {
-  ChildProcess child(publishing_writer(name(), 5));
+  ForkedChild child(publishing_writer(name(), 5));
   ASSERT_TRUE(child.wait_for_child(kHandshakeMs));
   auto reader = ShmPoseReader::open(name());
   ASSERT_TRUE(reader) << reader.error().message;
@@ -174,7 +174,7 @@ TEST_F(ShmLifecycle, KilledWriterIsReportedDead) {
 }
 
 TEST_F(ShmLifecycle, BlockedReaderLearnsThatWriterWasKilled) {
-  ChildProcess child(publishing_writer(name(), 1));
+  ForkedChild child(publishing_writer(name(), 1));
   ASSERT_TRUE(child.wait_for_child(kHandshakeMs));
   auto reader = ShmPoseReader::open(name());
   ASSERT_TRUE(reader) << reader.error().message;
@@ -189,7 +189,7 @@ TEST_F(ShmLifecycle, BlockedReaderLearnsThatWriterWasKilled) {
 }
 
 TEST_F(ShmLifecycle, NewWriterReplacesSegmentOfKilledWriter) {
-  ChildProcess child(publishing_writer(name(), 5));
+  ForkedChild child(publishing_writer(name(), 5));
   ASSERT_TRUE(child.wait_for_child(kHandshakeMs));
   auto old_reader = ShmPoseReader::open(name());
   ASSERT_TRUE(old_reader) << old_reader.error().message;
@@ -204,7 +204,7 @@ TEST_F(ShmLifecycle, NewWriterReplacesSegmentOfKilledWriter) {
 }
 
 TEST_F(ShmLifecycle, ReaderAcrossWriterRestartSeesRestartedAndReattaches) {
-  auto first = std::make_unique<ChildProcess>(publishing_writer(name(), 5));
+  auto first = std::make_unique<ForkedChild>(publishing_writer(name(), 5));
   ASSERT_TRUE(first->wait_for_child(kHandshakeMs));
   auto reader = ShmPoseReader::open(name());
   ASSERT_TRUE(reader) << reader.error().message;
@@ -217,7 +217,7 @@ TEST_F(ShmLifecycle, ReaderAcrossWriterRestartSeesRestartedAndReattaches) {
   ASSERT_EQ(first->wait_exit(20'000), 0);
   EXPECT_EQ(reader->liveness(kDefaultStaleAfterMs), Liveness::kStopped);
 
-  ChildProcess second(publishing_writer(name(), 2));
+  ForkedChild second(publishing_writer(name(), 2));
   ASSERT_TRUE(second.wait_for_child(kHandshakeMs));
   EXPECT_EQ(reader->liveness(kDefaultStaleAfterMs), Liveness::kRestarted);
   ASSERT_TRUE(reader->reattach());

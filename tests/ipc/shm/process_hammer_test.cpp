@@ -11,7 +11,7 @@ namespace ceilpose {
 namespace {
 
 using test::check_pose;
-using test::ChildProcess;
+using test::ForkedChild;
 using test::is_consistent;
 using test::kSanitizerDivisor;
 using test::ScopedSegmentName;
@@ -20,8 +20,8 @@ constexpr int kHandshakeMs = 20'000;
 
 // Creates the writer, tells the parent, and once released publishes
 // check_pose(1..updates) as fast as it can.
-ChildProcess::Body hammering_writer(const std::string& name, uint64_t updates) {
-  return test::writer_child(name, [updates](ShmPoseWriter& writer, ChildProcess& self) {
+ForkedChild::Body hammering_writer(const std::string& name, uint64_t updates) {
+  return test::writer_child(name, [updates](ShmPoseWriter& writer, ForkedChild& self) {
     self.notify_parent();
     if (!self.wait_for_parent(kHandshakeMs)) return 11;
     for (uint64_t k = 1; k <= updates; ++k) writer.publish(check_pose(k));
@@ -32,7 +32,7 @@ ChildProcess::Body hammering_writer(const std::string& name, uint64_t updates) {
 TEST(ShmProcessHammer, ReaderProcessNeverSeesTornPoseFromWriterProcess) {
   ScopedSegmentName name;
   const uint64_t updates = 3'000'000 / kSanitizerDivisor;
-  ChildProcess child(hammering_writer(name.str(), updates));
+  ForkedChild child(hammering_writer(name.str(), updates));
   ASSERT_TRUE(child.wait_for_child(kHandshakeMs)) << "writer child did not start";
   auto reader = ShmPoseReader::open(name.str());
   ASSERT_TRUE(reader) << reader.error().message;
@@ -63,7 +63,7 @@ TEST(ShmProcessHammer, ReaderProcessNeverSeesTornPoseFromWriterProcess) {
 TEST(ShmProcessHammer, BlockedReaderProcessGetsPosesInOrderFromWriterProcess) {
   ScopedSegmentName name;
   const uint64_t poses = 50'000 / kSanitizerDivisor;
-  ChildProcess child(hammering_writer(name.str(), poses));
+  ForkedChild child(hammering_writer(name.str(), poses));
   ASSERT_TRUE(child.wait_for_child(kHandshakeMs));
   auto reader = ShmPoseReader::open(name.str());
   ASSERT_TRUE(reader) << reader.error().message;

@@ -68,7 +68,7 @@ void send_byte(int fd) {
 
 }  // namespace
 
-ChildProcess::ChildProcess(Body body) {
+ForkedChild::ForkedChild(Body body) {
   if (::pipe2(to_parent_, O_CLOEXEC) != 0 || ::pipe2(to_child_, O_CLOEXEC) != 0) {
     ADD_FAILURE() << "pipe2 failed: " << std::strerror(errno);
     return;
@@ -86,7 +86,7 @@ ChildProcess::ChildProcess(Body body) {
   to_child_[0] = -1;
 }
 
-ChildProcess::~ChildProcess() {
+ForkedChild::~ForkedChild() {
   if (pid_ > 0 && !reaped_) {
     ::kill(pid_, SIGKILL);
     ::waitpid(pid_, nullptr, 0);
@@ -96,16 +96,16 @@ ChildProcess::~ChildProcess() {
   }
 }
 
-bool ChildProcess::wait_for_child(int timeout_ms) { return wait_byte(to_parent_[0], timeout_ms); }
-void ChildProcess::release_child() { send_byte(to_child_[1]); }
-void ChildProcess::notify_parent() { send_byte(to_parent_[1]); }
-bool ChildProcess::wait_for_parent(int timeout_ms) { return wait_byte(to_child_[0], timeout_ms); }
+bool ForkedChild::wait_for_child(int timeout_ms) { return wait_byte(to_parent_[0], timeout_ms); }
+void ForkedChild::release_child() { send_byte(to_child_[1]); }
+void ForkedChild::notify_parent() { send_byte(to_parent_[1]); }
+bool ForkedChild::wait_for_parent(int timeout_ms) { return wait_byte(to_child_[0], timeout_ms); }
 
-void ChildProcess::kill_child(int signal) {
+void ForkedChild::kill_child(int signal) {
   if (pid_ > 0 && !reaped_) ::kill(pid_, signal);
 }
 
-int ChildProcess::wait_exit(int timeout_ms) {
+int ForkedChild::wait_exit(int timeout_ms) {
   if (pid_ <= 0) return -1;
   const int64_t deadline = monotonic_ns() + int64_t{timeout_ms} * 1'000'000;
   for (;;) {
@@ -122,9 +122,9 @@ int ChildProcess::wait_exit(int timeout_ms) {
   }
 }
 
-ChildProcess::Body writer_child(const std::string& name,
-                                std::function<int(ShmPoseWriter&, ChildProcess&)> then) {
-  return [name, then](ChildProcess& self) {
+ForkedChild::Body writer_child(const std::string& name,
+                               std::function<int(ShmPoseWriter&, ForkedChild&)> then) {
+  return [name, then](ForkedChild& self) {
     ShmOptions options;
     options.name = name;
     auto writer = ShmPoseWriter::create(options);

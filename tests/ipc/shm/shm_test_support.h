@@ -48,16 +48,17 @@ PoseRecord check_pose(uint64_t k);
 // True when every field agrees with p.seq (the pose was copied whole).
 bool is_consistent(const PoseRecord& p);
 
-// A forked child running `body`; the child exits with body's return value
-// (never returns into the test framework). The child can signal the parent
-// once with notify_parent(), the parent can release it with release_child().
-class ChildProcess {
+// A forked child running `body` in a copy of the test process (a separate
+// program runs through tests/support's ChildProcess instead); the child
+// exits with body's return value (never returns into the test framework). The child can signal the
+// parent once with notify_parent(), the parent can release it with release_child().
+class ForkedChild {
  public:
-  using Body = std::function<int(ChildProcess&)>;
-  explicit ChildProcess(Body body);
-  ~ChildProcess();  // kills and reaps the child if still running
-  ChildProcess(const ChildProcess&) = delete;
-  ChildProcess& operator=(const ChildProcess&) = delete;
+  using Body = std::function<int(ForkedChild&)>;
+  explicit ForkedChild(Body body);
+  ~ForkedChild();  // kills and reaps the child if still running
+  ForkedChild(const ForkedChild&) = delete;
+  ForkedChild& operator=(const ForkedChild&) = delete;
 
   pid_t pid() const { return pid_; }
   // Parent side: waits up to timeout_ms for the child's notify; false on
@@ -82,8 +83,8 @@ class ChildProcess {
 
 // A child body that creates a writer on `name` (exit 10 if it cannot) and
 // then runs `then` with it.
-ChildProcess::Body writer_child(const std::string& name,
-                                std::function<int(ShmPoseWriter&, ChildProcess&)> then);
+ForkedChild::Body writer_child(const std::string& name,
+                               std::function<int(ShmPoseWriter&, ForkedChild&)> then);
 
 // A unique segment name per test, plus a writer and a reader on it.
 class ShmFixture : public ::testing::Test {
