@@ -7,6 +7,7 @@
 #include "ceilpose/pose_client.h"
 #include "ipc/shm/shm_pose_writer.h"
 #include "shm_test_support.h"
+#include "tests/support/child_process.h"
 
 namespace ceilpose {
 namespace {
@@ -133,23 +134,18 @@ TEST_F(CClient, ExamplePrinterPrintsPublishedPoses) {
       writer().publish(check_pose(k));
     }
   });
-  std::string out;
-  std::string err;
-  const int rc = test::run_program(CEILPOSE_POSE_PRINTER_PATH, {"--shm", name(), "--count", "3"},
-                                   30'000, &out, &err);
+  const test::RunOutput r =
+      test::run_to_end({CEILPOSE_POSE_PRINTER_PATH, "--shm", name(), "--count", "3"}, 30'000);
   more.join();
-  EXPECT_EQ(rc, 0) << err;
-  EXPECT_EQ(std::count(out.begin(), out.end(), '\n'), 3) << out;
-  EXPECT_NE(out.find("seq"), std::string::npos) << out;
+  EXPECT_EQ(r.exit_code, 0) << r.err << r.failure;
+  EXPECT_EQ(std::count(r.out.begin(), r.out.end(), '\n'), 3) << r.out;
+  EXPECT_NE(r.out.find("seq"), std::string::npos) << r.out;
 }
 
 TEST_F(CClient, ExamplePrinterExitsNoDaemonWhenSegmentMissing) {
-  std::string out;
-  std::string err;
-  const int rc =
-      test::run_program(CEILPOSE_POSE_PRINTER_PATH, {"--shm", name()}, 30'000, &out, &err);
-  EXPECT_EQ(rc, 3) << err;
-  EXPECT_NE(err.find(name()), std::string::npos) << err;
+  const test::RunOutput r = test::run_to_end({CEILPOSE_POSE_PRINTER_PATH, "--shm", name()}, 30'000);
+  EXPECT_EQ(r.exit_code, 3) << r.err << r.failure;
+  EXPECT_NE(r.err.find(name()), std::string::npos) << r.err;
 }
 
 }  // namespace

@@ -5,11 +5,13 @@
 #include <atomic>
 #include <chrono>
 #include <thread>
+#include <vector>
 
 #include "core/clock.h"
 #include "ipc/shm/shm_pose_reader.h"
 #include "ipc/shm/shm_pose_writer.h"
 #include "shm_test_support.h"
+#include "tests/support/child_process.h"
 
 namespace ceilpose {
 namespace {
@@ -20,10 +22,26 @@ constexpr int kRunTimeoutMs = 30'000;
 // expect a live pose must not find it stale because of that.
 const char* const kLenientStaleMs = "60000";
 
+// ceilposectl's command line with `args`.
+std::vector<std::string> ctl(const std::vector<std::string>& args) {
+  std::vector<std::string> argv{CEILPOSECTL_PATH};
+  argv.insert(argv.end(), args.begin(), args.end());
+  return argv;
+}
+
+test::ChildOptions capturing_stderr() {
+  test::ChildOptions options;
+  options.capture_stderr = true;
+  return options;
+}
+
 class CtlCommands : public test::ShmFixture {
  protected:
   int run(const std::vector<std::string>& args) {
-    return test::run_program(CEILPOSECTL_PATH, args, kRunTimeoutMs, &out_, &err_);
+    test::RunOutput r = test::run_to_end(ctl(args), kRunTimeoutMs);
+    out_ = std::move(r.out);
+    err_ = std::move(r.err);
+    return r.exit_code;
   }
   std::string out_;
   std::string err_;
@@ -182,35 +200,40 @@ TEST_F(CtlCommands, WatchJsonStreamsCountPosesAsTheyArePublished) {
 }
 
 TEST_F(CtlCommands, WatchWaitsForDaemonThatStartsLater) {
-  test::SpawnedProgram watch(CEILPOSECTL_PATH,
-                             {"watch", "--shm", name(), "--json", "--count", "2"});
-  ASSERT_TRUE(watch.started());
-  ASSERT_TRUE(watch.wait_for_stderr("waiting for ceilposed", kRunTimeoutMs)) << watch.err();
+  test::ChildProcess watch(ctl({"watch", "--shm", name(), "--json", "--count", "2"}),
+                           capturing_stderr());
+  ASSERT_TRUE(watch.started()) << watch.start_error();
+  ASSERT_TRUE(contains(watch.read_error_until("waiting for ceilposed", kRunTimeoutMs),
+                       "waiting for ceilposed"))
+      << watch.error_output();
   ASSERT_NO_FATAL_FAILURE(start());
   writer().publish(sample_pose(1));
-  ASSERT_TRUE(watch.wait_for_stdout("\"seq\":1,", kRunTimeoutMs)) << watch.err();
+  ASSERT_TRUE(contains(watch.read_until("\"seq\":1,", kRunTimeoutMs), "\"seq\":1,"))
+      << watch.error_output();
   writer().publish(sample_pose(2));
-  EXPECT_EQ(watch.finish(kRunTimeoutMs), 0) << watch.err();
-  EXPECT_EQ(count_lines(watch.out()), 2u) << watch.out();
+  EXPECT_EQ(watch.wait_exit(kRunTimeoutMs), 0) << watch.error_output();
+  EXPECT_EQ(count_lines(watch.output()), 2u) << watch.output();
 }
 
 TEST_F(CtlCommands, WatchReattachesAcrossDaemonRestart) {
   ASSERT_NO_FATAL_FAILURE(start());
   writer().publish(sample_pose(1));
-  test::SpawnedProgram watch(CEILPOSECTL_PATH,
-                             {"watch", "--shm", name(), "--json", "--count", "2"});
-  ASSERT_TRUE(watch.started());
-  ASSERT_TRUE(watch.wait_for_stdout("\"seq\":1,", kRunTimeoutMs)) << watch.err();
+  test::ChildProcess watch(ctl({"watch", "--shm", name(), "--json", "--count", "2"}),
+                           capturing_stderr());
+  ASSERT_TRUE(watch.started()) << watch.start_error();
+  ASSERT_TRUE(contains(watch.read_until("\"seq\":1,", kRunTimeoutMs), "\"seq\":1,"))
+      << watch.error_output();
   writer_.reset();  // the first daemon stops cleanly
   ShmOptions options;
   options.name = name();
   auto second = ShmPoseWriter::create(options);
   ASSERT_TRUE(second) << second.error().message;
-  ASSERT_TRUE(watch.wait_for_stderr("re-attached", kRunTimeoutMs)) << watch.err();
+  ASSERT_TRUE(contains(watch.read_error_until("re-attached", kRunTimeoutMs), "re-attached"))
+      << watch.error_output();
   second->publish(sample_pose(7));
-  EXPECT_EQ(watch.finish(kRunTimeoutMs), 0) << watch.err();
-  EXPECT_EQ(count_lines(watch.out()), 2u) << watch.out();
-  EXPECT_TRUE(contains(watch.out(), "\"timestamp_ns\":7")) << watch.out();
+  EXPECT_EQ(watch.wait_exit(kRunTimeoutMs), 0) << watch.error_output();
+  EXPECT_EQ(count_lines(watch.output()), 2u) << watch.output();
+  EXPECT_TRUE(contains(watch.output(), "\"timestamp_ns\":7")) << watch.output();
 }
 
 TEST_F(CtlCommands, WatchTablePrintsHeaderAndRows) {

@@ -4,7 +4,6 @@
 #include <gtest/gtest.h>
 #include <poll.h>
 #include <signal.h>
-#include <spawn.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -13,8 +12,6 @@
 #include <cstring>
 
 #include "core/clock.h"
-
-extern char** environ;
 
 namespace ceilpose::test {
 
@@ -143,111 +140,6 @@ void ShmFixture::start(int heartbeat_period_ms) {
   auto reader = ShmPoseReader::open(name());
   ASSERT_TRUE(reader) << reader.error().message;
   reader_.emplace(std::move(reader.value()));
-}
-
-SpawnedProgram::SpawnedProgram(const std::string& path, const std::vector<std::string>& args) {
-  int out[2];
-  int err[2];
-  if (::pipe2(out, O_CLOEXEC) != 0) return;
-  if (::pipe2(err, O_CLOEXEC) != 0) {
-    ::close(out[0]);
-    ::close(out[1]);
-    return;
-  }
-  posix_spawn_file_actions_t actions;
-  posix_spawn_file_actions_init(&actions);
-  posix_spawn_file_actions_adddup2(&actions, out[1], 1);
-  posix_spawn_file_actions_adddup2(&actions, err[1], 2);
-  std::vector<char*> argv;
-  argv.push_back(const_cast<char*>(path.c_str()));
-  for (const auto& a : args) argv.push_back(const_cast<char*>(a.c_str()));
-  argv.push_back(nullptr);
-  pid_t pid = -1;
-  const int rc = ::posix_spawn(&pid, path.c_str(), &actions, nullptr, argv.data(), environ);
-  posix_spawn_file_actions_destroy(&actions);
-  ::close(out[1]);
-  ::close(err[1]);
-  out_fd_ = out[0];
-  err_fd_ = err[0];
-  if (rc == 0) pid_ = pid;
-}
-
-SpawnedProgram::~SpawnedProgram() {
-  if (pid_ > 0) {
-    ::kill(pid_, SIGKILL);
-    ::waitpid(pid_, nullptr, 0);
-  }
-  for (int fd : {out_fd_, err_fd_}) {
-    if (fd >= 0) ::close(fd);
-  }
-}
-
-bool SpawnedProgram::pump(int timeout_ms) {
-  pollfd pfds[2] = {{out_fd_, POLLIN, 0}, {err_fd_, POLLIN, 0}};
-  if (out_fd_ < 0 && err_fd_ < 0) return false;
-  if (::poll(pfds, 2, timeout_ms) <= 0) return true;
-  char buf[4096];
-  for (int i = 0; i < 2; ++i) {
-    if ((pfds[i].revents & (POLLIN | POLLHUP | POLLERR)) == 0) continue;
-    int& fd = i == 0 ? out_fd_ : err_fd_;
-    const ssize_t n = ::read(fd, buf, sizeof buf);
-    if (n > 0) {
-      (i == 0 ? out_ : err_).append(buf, static_cast<size_t>(n));
-    } else {
-      ::close(fd);
-      fd = -1;
-    }
-  }
-  return true;
-}
-
-bool SpawnedProgram::wait_for_stdout(const std::string& text, int timeout_ms) {
-  const int64_t deadline = monotonic_ns() + int64_t{timeout_ms} * 1'000'000;
-  while (out_.find(text) == std::string::npos) {
-    const int64_t left_ms = (deadline - monotonic_ns()) / 1'000'000;
-    if (left_ms <= 0 || !pump(static_cast<int>(left_ms))) return false;
-  }
-  return true;
-}
-
-bool SpawnedProgram::wait_for_stderr(const std::string& text, int timeout_ms) {
-  const int64_t deadline = monotonic_ns() + int64_t{timeout_ms} * 1'000'000;
-  while (err_.find(text) == std::string::npos) {
-    const int64_t left_ms = (deadline - monotonic_ns()) / 1'000'000;
-    if (left_ms <= 0 || !pump(static_cast<int>(left_ms))) return false;
-  }
-  return true;
-}
-
-int SpawnedProgram::finish(int timeout_ms) {
-  if (pid_ <= 0) return -1;
-  const int64_t deadline = monotonic_ns() + int64_t{timeout_ms} * 1'000'000;
-  bool timed_out = false;
-  for (;;) {
-    const int64_t left_ms = (deadline - monotonic_ns()) / 1'000'000;
-    if (left_ms <= 0) {
-      timed_out = true;
-      break;
-    }
-    if (!pump(static_cast<int>(left_ms))) break;
-  }
-  if (timed_out) ::kill(pid_, SIGKILL);
-  int status = 0;
-  ::waitpid(pid_, &status, 0);
-  pid_ = -1;
-  if (timed_out) return -1;
-  if (WIFEXITED(status)) return WEXITSTATUS(status);
-  return 128 + WTERMSIG(status);
-}
-
-int run_program(const std::string& path, const std::vector<std::string>& args, int timeout_ms,
-                std::string* stdout_text, std::string* stderr_text) {
-  SpawnedProgram program(path, args);
-  if (!program.started()) return -1;
-  const int rc = program.finish(timeout_ms);
-  if (stdout_text != nullptr) *stdout_text = program.out();
-  if (stderr_text != nullptr) *stderr_text = program.err();
-  return rc;
 }
 
 }  // namespace ceilpose::test

@@ -9,7 +9,6 @@
 #include <functional>
 #include <optional>
 #include <string>
-#include <vector>
 
 #include "ipc/shm/pose_record.h"
 #include "ipc/shm/shm_pose_reader.h"
@@ -49,9 +48,10 @@ PoseRecord check_pose(uint64_t k);
 bool is_consistent(const PoseRecord& p);
 
 // A forked child running `body` in a copy of the test process (a separate
-// program runs through tests/support's ChildProcess instead); the child
-// exits with body's return value (never returns into the test framework). The child can signal the
-// parent once with notify_parent(), the parent can release it with release_child().
+// program runs through tests/support's ChildProcess instead). The child
+// exits with body's return value (never returns into the test framework).
+// It can signal the parent once with notify_parent(), the parent can
+// release it with release_child().
 class ForkedChild {
  public:
   using Body = std::function<int(ForkedChild&)>;
@@ -99,39 +99,5 @@ class ShmFixture : public ::testing::Test {
   std::optional<ShmPoseWriter> writer_;
   std::optional<ShmPoseReader> reader_;
 };
-
-// A program run as a child process with stdout and stderr captured, so a
-// test can react to what it prints before it ends.
-class SpawnedProgram {
- public:
-  SpawnedProgram(const std::string& path, const std::vector<std::string>& args);
-  ~SpawnedProgram();  // kills and reaps it if still running
-  SpawnedProgram(const SpawnedProgram&) = delete;
-  SpawnedProgram& operator=(const SpawnedProgram&) = delete;
-
-  bool started() const { return pid_ > 0; }
-  // Reads output until `text` appears on stdout (or stderr) or timeout_ms passes.
-  bool wait_for_stdout(const std::string& text, int timeout_ms);
-  bool wait_for_stderr(const std::string& text, int timeout_ms);
-  // Reads to the end; returns the exit status (128+signal if killed), -1 on
-  // timeout (the child is then killed).
-  int finish(int timeout_ms);
-  const std::string& out() const { return out_; }
-  const std::string& err() const { return err_; }
-
- private:
-  // Reads whatever is available within timeout_ms; false once both pipes closed.
-  bool pump(int timeout_ms);
-  pid_t pid_ = -1;
-  int out_fd_ = -1;
-  int err_fd_ = -1;
-  std::string out_;
-  std::string err_;
-};
-
-// Runs `path args...` to the end with output captured; returns the exit
-// status (-1 on timeout, the child is then killed).
-int run_program(const std::string& path, const std::vector<std::string>& args, int timeout_ms,
-                std::string* stdout_text, std::string* stderr_text = nullptr);
 
 }  // namespace ceilpose::test
