@@ -1,24 +1,26 @@
 #include "tests/systemd/run_command.h"
 
 #include <gtest/gtest.h>
-#include <stdio.h>
-#include <sys/wait.h>
 #include <unistd.h>
 
 #include <filesystem>
 
+#include "tests/support/child_process.h"
+
 namespace ceilpose::test {
+namespace {
+
+// Under packaging_tests' ctest TIMEOUT (600 s), so a hung command fails the
+// test with its name rather than being killed by ctest without one.
+constexpr int kCommandTimeoutMs = 540'000;
+
+}  // namespace
 
 CommandResult run_command(const std::string& command) {
-  CommandResult r;
-  FILE* pipe = popen((command + " 2>&1").c_str(), "r");
-  if (pipe == nullptr) return r;
-  char buf[4096];
-  size_t n = 0;
-  while ((n = fread(buf, 1, sizeof(buf), pipe)) > 0) r.output.append(buf, n);
-  const int status = pclose(pipe);
-  r.status = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  return r;
+  const RunOutput r = run_to_end({"/bin/sh", "-c", command + " 2>&1"}, kCommandTimeoutMs);
+  if (!r.failure.empty()) ADD_FAILURE() << "`" << command << "`: " << r.failure;
+  // r.err holds only what the shell itself said (a syntax error, say).
+  return {r.exit_code, r.out + r.err};
 }
 
 bool have_tool(const std::string& name) {
