@@ -19,6 +19,8 @@
 #include <string>
 #include <vector>
 
+#include "independent_metrics_support.h"
+#include "independent_recording_support.h"
 #include "independent_renderer_support.h"
 #include "pipeline/pipeline.h"
 #include "recording/recording_reader.h"
@@ -26,21 +28,12 @@
 namespace ceilpose {
 namespace {
 
-using testing::xcheck::XCamera;
-using testing::xcheck::XMount;
-using testing::xcheck::XPose;
-using testing::xcheck::XRenderOptions;
+// The independent renderer, its recordings and SPEC §6 figures.
+using namespace testing::xcheck;
 
-constexpr double kGrid_m = 0.6096;
+constexpr double kGrid_m = testing::xcheck::kGridUnit_m;
 constexpr double kPi = std::numbers::pi;
-
-int frames_for(int release_frames) {
-#if defined(__SANITIZE_ADDRESS__) || defined(__SANITIZE_THREAD__)
-  return std::max(6, release_frames / 6);
-#else
-  return release_frames;
-#endif
-}
+constexpr auto wrapped = testing::xcheck::wrapped_rad;
 
 PipelineConfig config_for(const XCamera& camera, const XMount& mount) {
   PipelineConfig config;
@@ -63,36 +56,6 @@ ImageView view_of(const cv::Mat& m, PixelFormat format) {
       m.data, m.cols, m.rows, static_cast<int>(m.step), format, m.total() * m.elemSize()};
 }
 
-double wrapped(double a) { return std::remainder(a, 2.0 * kPi); }
-
-double percentile(std::vector<double> v, double q) {
-  if (v.empty()) return 0.0;
-  std::sort(v.begin(), v.end());
-  const size_t k = static_cast<size_t>(std::ceil(q * static_cast<double>(v.size()))) - 1;
-  return v[std::min(k, v.size() - 1)];
-}
-
-// SPEC §6 figures of one case.
-struct CaseFigures {
-  int frames = 0;
-  int with_whole = 0;
-  int valid_with_whole = 0;
-  int valid = 0;
-  int within_both = 0;
-  int gross = 0;
-  int wrong_codes = 0;  // decoded codes not matching the marker drawn there
-  int decoded = 0;
-  std::vector<double> error_mm;
-  double sum_forward_mm = 0.0;  // signed error in the robot frame: a bent
-  double sum_left_mm = 0.0;     // pixel or axis convention shows as a bias
-  std::vector<double> yaw_error_deg;
-
-  double bias_forward_mm() const { return valid ? sum_forward_mm / valid : 0.0; }
-  double bias_left_mm() const { return valid ? sum_left_mm / valid : 0.0; }
-  double availability() const { return with_whole ? double(valid_with_whole) / with_whole : 1.0; }
-  double both_share() const { return valid ? double(within_both) / valid : 0.0; }
-};
-
 struct Case {
   std::string name;
   XCamera camera;
@@ -106,14 +69,14 @@ struct Case {
   uint64_t seed = 1;
 };
 
-CaseFigures run_case(const Case& c, uint64_t seed) {
+Spec6Figures run_case(const Case& c, uint64_t seed) {
   std::mt19937_64 rng(seed);
   std::uniform_real_distribution<double> along(0.0, 7.0 * kGrid_m);
   std::uniform_real_distribution<double> yaw(-kPi, kPi);
   std::uniform_real_distribution<double> near_pi(-0.02, 0.02);
   Pipeline pipeline(config_for(c.camera, c.mount));
   auto result = std::make_unique<FrameResult>();
-  CaseFigures f;
+  Spec6Figures f;
   const int frames = frames_for(c.frames);
   for (int k = 0; k < frames; ++k) {
     XPose truth{along(rng), along(rng), c.yaw_near_pi ? kPi + near_pi(rng) : yaw(rng)};
@@ -125,9 +88,6 @@ CaseFigures run_case(const Case& c, uint64_t seed) {
     const cv::Mat rgb =
         testing::xcheck::render_rgb(c.render_camera.value_or(c.camera), c.mount, truth, options);
     pipeline.process(view_of(rgb, PixelFormat::kRgb24), PositioningMode::kAuto, result.get());
-    const bool whole = !testing::xcheck::whole_markers(c.camera, c.mount, truth).empty();
-    ++f.frames;
-    f.with_whole += whole;
     for (int m = 0; m < result->marker_count; ++m) {
       const MarkerObservation& obs = result->markers[m];
       ++f.decoded;
@@ -136,41 +96,23 @@ CaseFigures run_case(const Case& c, uint64_t seed) {
       if (std::hypot(drawn.x - obs.centre_u_px, drawn.y - obs.centre_v_px) > 3.0) ++f.wrong_codes;
     }
     const PoseEstimate& e = result->estimate;
-    if (!e.valid) continue;
-    ++f.valid;
-    f.valid_with_whole += whole;
-    const double dx_m = e.pose.x_m - truth.x_m, dy_m = e.pose.y_m - truth.y_m;
-    const double dyaw_deg = std::abs(wrapped(e.pose.yaw_rad - truth.yaw_rad)) * 180.0 / kPi;
-    const double err_m = std::hypot(dx_m, dy_m);
-    EXPECT_GT(e.pose.yaw_rad, -kPi) << c.name << " frame " << k;
-    EXPECT_LE(e.pose.yaw_rad, kPi) << c.name << " frame " << k;
-    f.within_both += std::abs(dx_m) <= 0.05 * kGrid_m && std::abs(dy_m) <= 0.05 * kGrid_m;
-    f.gross += err_m > 0.25 * kGrid_m || dyaw_deg > 5.0;
-    f.error_mm.push_back(err_m * 1000.0);
-    const double c_yaw = std::cos(truth.yaw_rad), s_yaw = std::sin(truth.yaw_rad);
-    f.sum_forward_mm += (c_yaw * dx_m + s_yaw * dy_m) * 1000.0;
-    f.sum_left_mm += (-s_yaw * dx_m + c_yaw * dy_m) * 1000.0;
-    f.yaw_error_deg.push_back(dyaw_deg);
+    f.add(truth, !testing::xcheck::whole_markers(c.camera, c.mount, truth).empty(),
+          e.valid ? std::optional<XPose>(XPose{e.pose.x_m, e.pose.y_m, e.pose.yaw_rad})
+                  : std::nullopt);
   }
-  std::printf(
-      "[xcheck] %-14s frames %3d  avail %.3f  both-axes %.3f  median %.2f mm  p99 %.2f mm  "
-      "max %.2f mm  yaw p99 %.3f deg  max %.3f deg  gross %d  decoded %d  wrong %d  "
-      "bias fwd %+.2f left %+.2f mm\n",
-      c.name.c_str(), f.frames, f.availability(), f.both_share(), percentile(f.error_mm, 0.5),
-      percentile(f.error_mm, 0.99), percentile(f.error_mm, 1.0), percentile(f.yaw_error_deg, 0.99),
-      percentile(f.yaw_error_deg, 1.0), f.gross, f.decoded, f.wrong_codes, f.bias_forward_mm(),
-      f.bias_left_mm());
+  f.print("xcheck", c.name);
   return f;
 }
 
 void expect_spec_accuracy(const Case& c, uint64_t seed) {
-  const CaseFigures f = run_case(c, seed);
+  const Spec6Figures f = run_case(c, seed);
   ASSERT_GT(f.with_whole, 0) << c.name;
   EXPECT_GE(f.availability(), 0.98) << c.name;
   EXPECT_GE(f.both_share(), 0.99) << c.name;
-  EXPECT_LE(percentile(f.error_mm, 0.99), 10.0) << c.name;
-  EXPECT_LE(percentile(f.yaw_error_deg, 1.0), 0.5) << c.name;
+  EXPECT_LE(f.p99_mm(), 10.0) << c.name;
+  EXPECT_LE(f.yaw_max_deg(), 0.5) << c.name;
   EXPECT_EQ(f.gross, 0) << c.name;
+  EXPECT_EQ(f.yaw_out_of_range, 0) << c.name;
   EXPECT_EQ(f.wrong_codes, 0) << c.name;
 }
 
@@ -288,7 +230,7 @@ TEST(IndependentRender, HalfPixelConventionShiftShowsAsTwoMillimetreBias) {
   corner_origin.cy += 0.5;
   c.render_camera = corner_origin;
   c.frames = 30;
-  const CaseFigures f = run_case(c, 915);
+  const Spec6Figures f = run_case(c, 915);
   ASSERT_GT(f.valid, 0);
   const double half_px_mm = 0.5 * (2.4384 - 0.3048) / 530.0 * 1000.0;
   EXPECT_NEAR(f.bias_forward_mm(), half_px_mm, 0.6);
@@ -358,6 +300,48 @@ TEST(IndependentRender, GreyInputGivesNoPoseAndNoMarkers) {
   EXPECT_EQ(result->marker_count, 0);
 }
 
+// Known failure (docs/cross_check.md): a warm cast of (1.25, 1, 0.75) or more
+// in sRGB values saturates the tile beyond what the tile-reference sample
+// accepts, so the frame keeps the previous frame's normalisation. Every frame
+// should give a pose, and the same one whether or not frames came before it
+// (SPEC §5: without --filter each frame is solved on its own). Prints the
+// figures per cast; run with --gtest_also_run_disabled_tests.
+TEST(IndependentRender, DISABLED_WarmCastEveryFrameValidWithOrWithoutHistory) {
+  const XCamera camera;
+  const XMount mount;
+  const int frames = frames_for(16);
+  for (const bool fixtures : {true, false}) {
+    for (const double cast : {0.2, 0.25, 0.3}) {
+      std::mt19937_64 rng(2303);
+      std::uniform_real_distribution<double> along(0.0, 7.0 * kGrid_m);
+      std::uniform_real_distribution<double> yaw(-kPi, kPi);
+      Pipeline sequential(config_for(camera, mount));
+      auto result = std::make_unique<FrameResult>();
+      int fresh_valid = 0, sequential_valid = 0;
+      for (int k = 0; k < frames; ++k) {
+        const XPose robot{along(rng), along(rng), yaw(rng)};
+        XRenderOptions options;
+        options.channel_gain = {1.0 + cast, 1.0, 1.0 - cast};
+        options.noise_sigma = 2.0;
+        options.light_fixtures = fixtures;
+        options.seed = static_cast<uint64_t>(k);
+        const cv::Mat rgb = testing::xcheck::render_rgb(camera, mount, robot, options);
+        Pipeline fresh(config_for(camera, mount));
+        fresh.process(view_of(rgb, PixelFormat::kRgb24), PositioningMode::kAuto, result.get());
+        fresh_valid += result->estimate.valid;
+        sequential.process(view_of(rgb, PixelFormat::kRgb24), PositioningMode::kAuto, result.get());
+        sequential_valid += result->estimate.valid;
+      }
+      std::printf(
+          "[xcheck] warm cast (%.2f, 1, %.2f) fixtures %d: valid %d/%d fresh pipeline, "
+          "%d/%d sequential\n",
+          1.0 + cast, 1.0 - cast, fixtures, fresh_valid, frames, sequential_valid, frames);
+      EXPECT_EQ(fresh_valid, frames) << "cast " << cast << " fixtures " << fixtures;
+      EXPECT_EQ(sequential_valid, fresh_valid) << "cast " << cast << " fixtures " << fixtures;
+    }
+  }
+}
+
 }  // namespace
 }  // namespace ceilpose
 
@@ -399,37 +383,19 @@ TEST(IndependentRender, SpecRecordingWrittenByHandIsReadAndLocalized) {
   namespace fs = std::filesystem;
   const fs::path dir =
       fs::temp_directory_path() / ("ceilpose_xcheck_" + std::to_string(::getpid()) + "_recording");
-  fs::remove_all(dir);
-  fs::create_directories(dir / "frames");
   XCamera camera;
   camera.distortion = {-0.2, 0.05, 0.001, -0.001, 0.0};
-  {
-    std::ofstream yaml(dir / "recording.yaml");
-    yaml << "format: ceilpose-recording\nversion: 1\ncamera:\n  width: 640\n  height: 480\n"
-            "  fx: 530.0\n  fy: 530.0\n  cx: 319.5\n  cy: 239.5\n"
-            "  distortion: [-0.2, 0.05, 0.001, -0.001, 0.0]   # k1 k2 p1 p2 k3\n"
-            "source: \"xcheck independent renderer\"\n";
-  }
+  testing::xcheck::XRecordingWriter writer(dir, camera, testing::xcheck::XFrameFile::kPngRgb);
   std::mt19937_64 rng(1001);
   std::uniform_real_distribution<double> along(0.3, 6.7 * kGrid_m);
   std::uniform_real_distribution<double> yaw(-kPi, kPi);
   std::vector<XPose> truth;
-  {
-    std::ofstream csv(dir / "frames.csv");
-    csv << "index,timestamp_ns,file,gt_x_m,gt_y_m,gt_yaw_rad,exposure_us\n";
-    csv.precision(9);
-    for (int k = 0; k < frames_for(8); ++k) {
-      const XPose pose{along(rng), along(rng), yaw(rng)};
-      truth.push_back(pose);
-      char file[32];
-      std::snprintf(file, sizeof file, "frames/%06d.png", k);
-      cv::Mat bgr;
-      cv::cvtColor(testing::xcheck::render_rgb(camera, XMount{}, pose, XRenderOptions{}), bgr,
-                   cv::COLOR_RGB2BGR);
-      ASSERT_TRUE(cv::imwrite((dir / file).string(), bgr));
-      csv << k << ',' << 1000000000LL + k * 33333333LL << ',' << file << ',' << pose.x_m << ','
-          << pose.y_m << ',' << pose.yaw_rad << ",8000\n";
-    }
+  for (int k = 0; k < frames_for(8); ++k) {
+    const XPose pose{along(rng), along(rng), yaw(rng)};
+    truth.push_back(pose);
+    ASSERT_TRUE(
+        writer.add(testing::xcheck::render_rgb(camera, XMount{}, pose, XRenderOptions{}), pose))
+        << writer.error();
   }
   auto reader = RecordingReader::open(dir.string());
   ASSERT_TRUE(reader.ok()) << reader.error().message;

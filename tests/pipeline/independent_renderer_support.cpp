@@ -19,11 +19,12 @@ namespace ceilpose::testing::xcheck {
 namespace {
 
 constexpr double kIn_m = 0.0254;
-constexpr double kCeiling_m = 2.4384;
 constexpr double kGrid_m = 0.6096;
 constexpr int kCodes = 8;
-// Far enough around the camera to cover the widest (distorted) view used.
-constexpr double kDrawRadius_m = 3.0;
+// Far enough around the camera to cover the widest (distorted) view used:
+// the widest lens sees about 1.4 lens-to-ceiling distances off axis.
+constexpr double kMinDrawRadius_m = 3.0;
+constexpr double kDrawRadiusPerDistance = 1.45;
 // Edge subdivision so that distortion bends the drawn outlines.
 constexpr double kEdgeStep_m = 0.005;
 constexpr int kFixedPointShift = 4;
@@ -53,6 +54,9 @@ class Projector {
     dist_ = cv::Mat(camera.distortion, true).reshape(1, 1);
     centre_x_m_ = centre_x_m;
     centre_y_m_ = centre_y_m;
+    ceiling_m_ = mount.ceiling_height_m;
+    draw_radius_m_ = std::max(
+        kMinDrawRadius_m, kDrawRadiusPerDistance * (mount.ceiling_height_m - mount.lens_height_m));
   }
 
   std::vector<cv::Point2d> project(const std::vector<cv::Point3d>& world) const {
@@ -63,14 +67,17 @@ class Projector {
 
   double centre_x_m() const { return centre_x_m_; }
   double centre_y_m() const { return centre_y_m_; }
+  double ceiling_m() const { return ceiling_m_; }
+  double draw_radius_m() const { return draw_radius_m_; }
 
  private:
   cv::Mat rvec_, tvec_, k_, dist_;
-  double centre_x_m_ = 0.0, centre_y_m_ = 0.0;
+  double centre_x_m_ = 0.0, centre_y_m_ = 0.0, ceiling_m_ = 0.0, draw_radius_m_ = 0.0;
 };
 
 // Closed outline of an axis-aligned ceiling rectangle, edges subdivided.
-std::vector<cv::Point3d> rectangle_outline(double x0_m, double y0_m, double x1_m, double y1_m) {
+std::vector<cv::Point3d> rectangle_outline(double x0_m, double y0_m, double x1_m, double y1_m,
+                                           double z_m) {
   std::vector<cv::Point3d> out;
   const std::array<cv::Point2d, 5> corners{cv::Point2d(x0_m, y0_m), cv::Point2d(x1_m, y0_m),
                                            cv::Point2d(x1_m, y1_m), cv::Point2d(x0_m, y1_m),
@@ -80,7 +87,7 @@ std::vector<cv::Point3d> rectangle_outline(double x0_m, double y0_m, double x1_m
     const int steps = std::max(1, static_cast<int>(std::ceil(cv::norm(b - a) / kEdgeStep_m)));
     for (int t = 0; t < steps; ++t) {
       const cv::Point2d p = a + (b - a) * (static_cast<double>(t) / steps);
-      out.emplace_back(p.x, p.y, kCeiling_m);
+      out.emplace_back(p.x, p.y, z_m);
     }
   }
   return out;
@@ -88,14 +95,13 @@ std::vector<cv::Point3d> rectangle_outline(double x0_m, double y0_m, double x1_m
 
 // Sampled outline of a ceiling ellipse; its image is then a true projected
 // conic (with distortion), not an image-space ellipse.
-std::vector<cv::Point3d> ellipse_outline(double cx_m, double cy_m, double full_e_m,
-                                         double full_n_m) {
+std::vector<cv::Point3d> ellipse_outline(double cx_m, double cy_m, double full_e_m, double full_n_m,
+                                         double z_m) {
   constexpr int kSamples = 64;
   std::vector<cv::Point3d> out;
   for (int k = 0; k < kSamples; ++k) {
     const double t = 2.0 * CV_PI * k / kSamples;
-    out.emplace_back(cx_m + 0.5 * full_e_m * std::cos(t), cy_m + 0.5 * full_n_m * std::sin(t),
-                     kCeiling_m);
+    out.emplace_back(cx_m + 0.5 * full_e_m * std::cos(t), cy_m + 0.5 * full_n_m * std::sin(t), z_m);
   }
   return out;
 }
@@ -120,29 +126,32 @@ void fill_world_polygon(const Projector& proj, const std::vector<cv::Point3d>& w
 int code_bit(int code, int slot) { return (code >> (2 - slot)) & 1; }
 
 void draw_marker(const Projector& proj, int i, int j, int ss, cv::Mat* canvas) {
-  const double x_m = i * kGrid_m, y_m = j * kGrid_m;
+  const double x_m = i * kGrid_m, y_m = j * kGrid_m, z_m = proj.ceiling_m();
   fill_world_polygon(proj,
-                     rectangle_outline(x_m, y_m - 6 * kIn_m, x_m + 5 * kIn_m, y_m + 6 * kIn_m), ss,
-                     kRed, canvas);
+                     rectangle_outline(x_m, y_m - 6 * kIn_m, x_m + 5 * kIn_m, y_m + 6 * kIn_m, z_m),
+                     ss, kRed, canvas);
   fill_world_polygon(proj,
-                     rectangle_outline(x_m - 5 * kIn_m, y_m - 6 * kIn_m, x_m, y_m + 6 * kIn_m), ss,
-                     kGreen, canvas);
+                     rectangle_outline(x_m - 5 * kIn_m, y_m - 6 * kIn_m, x_m, y_m + 6 * kIn_m, z_m),
+                     ss, kGreen, canvas);
   for (int slot = 0; slot < 3; ++slot) {
     const double n_m = (4.0 - 4.0 * slot) * kIn_m;  // slot 0 northernmost, the MSB
     if (code_bit(i, slot)) {
-      fill_world_polygon(proj, ellipse_outline(x_m + 2.5 * kIn_m, y_m + n_m, 2 * kIn_m, 1 * kIn_m),
+      fill_world_polygon(proj,
+                         ellipse_outline(x_m + 2.5 * kIn_m, y_m + n_m, 2 * kIn_m, 1 * kIn_m, z_m),
                          ss, kDot, canvas);
     }
     if (code_bit(j, slot)) {
-      fill_world_polygon(proj, ellipse_outline(x_m - 2.5 * kIn_m, y_m + n_m, 3 * kIn_m, 2 * kIn_m),
+      fill_world_polygon(proj,
+                         ellipse_outline(x_m - 2.5 * kIn_m, y_m + n_m, 3 * kIn_m, 2 * kIn_m, z_m),
                          ss, kDot, canvas);
     }
   }
 }
 
 void draw_rails_and_fixtures(const Projector& proj, int ss, bool fixtures, cv::Mat* canvas) {
-  const double x0 = proj.centre_x_m() - kDrawRadius_m, x1 = proj.centre_x_m() + kDrawRadius_m;
-  const double y0 = proj.centre_y_m() - kDrawRadius_m, y1 = proj.centre_y_m() + kDrawRadius_m;
+  const double r_m = proj.draw_radius_m(), z_m = proj.ceiling_m();
+  const double x0 = proj.centre_x_m() - r_m, x1 = proj.centre_x_m() + r_m;
+  const double y0 = proj.centre_y_m() - r_m, y1 = proj.centre_y_m() + r_m;
   const int i0 = static_cast<int>(std::floor(x0 / kGrid_m)),
             i1 = static_cast<int>(std::ceil(x1 / kGrid_m));
   const int j0 = static_cast<int>(std::floor(y0 / kGrid_m)),
@@ -156,7 +165,8 @@ void draw_rails_and_fixtures(const Projector& proj, int ss, bool fixtures, cv::M
         const cv::Scalar colour = pick == 0 ? cv::Scalar(255, 255, 255) : cv::Scalar(255, 244, 210);
         const double cx_m = (i + 0.5) * kGrid_m, cy_m = (j + 0.5) * kGrid_m, half_m = 0.15;
         fill_world_polygon(
-            proj, rectangle_outline(cx_m - half_m, cy_m - half_m, cx_m + half_m, cy_m + half_m), ss,
+            proj,
+            rectangle_outline(cx_m - half_m, cy_m - half_m, cx_m + half_m, cy_m + half_m, z_m), ss,
             colour, canvas);
       }
     }
@@ -164,19 +174,19 @@ void draw_rails_and_fixtures(const Projector& proj, int ss, bool fixtures, cv::M
   const double half_rail_m = 0.5 * kIn_m;
   for (int i = i0; i <= i1; ++i) {
     fill_world_polygon(
-        proj, rectangle_outline(i * kGrid_m - half_rail_m, y0, i * kGrid_m + half_rail_m, y1), ss,
-        kRail, canvas);
+        proj, rectangle_outline(i * kGrid_m - half_rail_m, y0, i * kGrid_m + half_rail_m, y1, z_m),
+        ss, kRail, canvas);
   }
   for (int j = j0; j <= j1; ++j) {
     fill_world_polygon(
-        proj, rectangle_outline(x0, j * kGrid_m - half_rail_m, x1, j * kGrid_m + half_rail_m), ss,
-        kRail, canvas);
+        proj, rectangle_outline(x0, j * kGrid_m - half_rail_m, x1, j * kGrid_m + half_rail_m, z_m),
+        ss, kRail, canvas);
   }
 }
 
 bool near_camera(const Projector& proj, int i, int j) {
   return std::hypot(i * kGrid_m - proj.centre_x_m(), j * kGrid_m - proj.centre_y_m()) <
-         kDrawRadius_m - 0.3;
+         proj.draw_radius_m() - 0.3;
 }
 
 // Camera colour response in sRGB values: white balance, gamma, then saturation about the
@@ -251,10 +261,10 @@ std::vector<XVisibleMarker> whole_markers(const XCamera& camera, const XMount& m
   for (int i = 0; i < kCodes; ++i) {
     for (int j = 0; j < kCodes; ++j) {
       if (!near_camera(proj, i, j)) continue;
-      const double x_m = i * kGrid_m, y_m = j * kGrid_m;
-      std::vector<cv::Point3d> outline =
-          rectangle_outline(x_m - 5 * kIn_m, y_m - 6 * kIn_m, x_m + 5 * kIn_m, y_m + 6 * kIn_m);
-      outline.emplace_back(x_m, y_m, kCeiling_m);  // the centre, last
+      const double x_m = i * kGrid_m, y_m = j * kGrid_m, z_m = proj.ceiling_m();
+      std::vector<cv::Point3d> outline = rectangle_outline(x_m - 5 * kIn_m, y_m - 6 * kIn_m,
+                                                           x_m + 5 * kIn_m, y_m + 6 * kIn_m, z_m);
+      outline.emplace_back(x_m, y_m, z_m);  // the centre, last
       const std::vector<cv::Point2d> image = proj.project(outline);
       const bool inside = std::all_of(image.begin(), image.end(), [&](const cv::Point2d& p) {
         return p.x >= 0.0 && p.y >= 0.0 && p.x <= camera.width - 1.0 && p.y <= camera.height - 1.0;
@@ -268,7 +278,7 @@ std::vector<XVisibleMarker> whole_markers(const XCamera& camera, const XMount& m
 cv::Point2d marker_centre_px(const XCamera& camera, const XMount& mount, const XPose& robot, int i,
                              int j) {
   const Projector proj(camera, mount, robot);
-  return proj.project({cv::Point3d(i * kGrid_m, j * kGrid_m, kCeiling_m)}).front();
+  return proj.project({cv::Point3d(i * kGrid_m, j * kGrid_m, proj.ceiling_m())}).front();
 }
 
 }  // namespace ceilpose::testing::xcheck

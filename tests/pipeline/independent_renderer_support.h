@@ -25,9 +25,11 @@ struct XCamera {
 
 // Where the camera sits on the robot: lens height, offset in the robot frame
 // (forward, left) and the yaw of the image-up direction relative to the
-// robot's forward axis, counter-clockwise.
+// robot's forward axis, counter-clockwise. The ceiling height (SPEC §1's H)
+// lives here too because only the lens-to-ceiling distance shapes the image.
 struct XMount {
   double lens_height_m = 0.3048;
+  double ceiling_height_m = 2.4384;
   double offset_forward_m = 0.0;
   double offset_left_m = 0.0;
   double yaw_rad = 0.0;
@@ -62,8 +64,8 @@ struct XVisibleMarker {
   double centre_v_px = 0.0;
 };
 
-// Renders the default `thesis3` ceiling (8 x 8 markers, H = 2.4384 m,
-// g = 0.6096 m) seen from `robot`. Returns an 8-bit RGB (R first) image.
+// Renders the default `thesis3` ceiling (8 x 8 markers, g = 0.6096 m, at
+// mount.ceiling_height_m) seen from `robot`. Returns an 8-bit RGB (R first) image.
 cv::Mat render_rgb(const XCamera& camera, const XMount& mount, const XPose& robot,
                    const XRenderOptions& options);
 
