@@ -78,27 +78,43 @@ struct DetectorParams {
   // A slot holds a dot when its brightness is below this fraction of the
   // rectangle's own brightness (dot ≈ 0.13–0.16 of it when sharp, up to
   // ≈ 0.55 for a red dot under 1 px defocus plus 3 px motion blur; an empty
-  // slot reads ≈ 1).
+  // slot reads ≈ 1), on a sharp marker; blur raises it (below).
   float dot_threshold_ratio = 0.72f;
   // How far either side of its slot, along North (metres on the ceiling), a
   // dot's darkest line is searched. Covers centroid shifts from glare or
   // partial occlusion; must stay below pitch − dot height (2 in by default).
   // Cost: one line of three samples per pixel searched.
   double dot_search_m = 0.0254;
-  // A marker is not decoded when any slot reads closer than this to
-  // dot_threshold_ratio: a dot washed out by blur would otherwise read as
-  // unset and give a valid-looking wrong code. Lower it to trade wrong
-  // codes for availability.
+  // A marker is not decoded when any slot reads closer than this to the
+  // threshold: a dot washed out by blur would otherwise read as unset, an
+  // empty slot darkened by distortion or an occluder's edge as set, either
+  // giving a valid-looking wrong code. Lower it to trade wrong codes for
+  // availability.
   float dot_min_margin = 0.1f;
+  // Blur washes dots towards their rectangle's brightness but leaves empty
+  // slots at ≈ 1 (noise and JPEG ringing take them down to ≈ 0.82), so the
+  // threshold rises by `dot_threshold_blur_shift` as the blur along North
+  // (edge_spread_px, fraction of the red dot's height in pixels) goes from
+  // `blur_shift_start` to `blur_shift_full`. Measured on the simulator: red
+  // dots of 3 px (320×240) under defocus ≤ 1.2 px, motion ≤ 3 px, noise and
+  // JPEG 60 read up to 0.88 at blur 0.5–0.7 of the dot, and with a fixed 0.72
+  // such a dot could pass as unset (2 wrong codes in 336); sharp ones read
+  // ≤ 0.47 even through JPEG, where empty slots dip to 0.77. The blur is
+  // taken as hypot(edge spread, sampling_blur_px): the spread is measured on
+  // the rectangle's darkest channel, while a 2–3 px dot also loses contrast
+  // to pixel sampling and to the halved chroma of JPEG and YUYV (0.7 px
+  // removed the wrong codes that dots shrunk to 2.2–2.7 px by lens
+  // distortion at 320×240 still gave). See docs/detection.md.
+  float dot_threshold_blur_shift = 0.1f;
+  float blur_shift_start = 0.4f;
+  float blur_shift_full = 0.6f;
+  float sampling_blur_px = 0.7f;
   // A marker is not decoded when the blur along North (edge_spread_px at
   // the red rectangle's ends, 25–75 % rise) exceeds this fraction of the red
   // dot's height in pixels: such blur can wash a 1 in dot out completely,
   // and an unset slot then looks confidently unset. Sharp edges spread
-  // 0.5 px. Measured on the simulator: at 640×480 (6.3 px dots) 0.75 refuses
-  // nothing of the stress, defocus and 2–10 px motion-blur sets; at 320×240
-  // under stress levels (3 px dots, JPEG 60) it refuses some markers and
-  // 2 of ~340 decoded still carry a wrong code (0.6: 1, at the cost of 8 %
-  // of the motion-blur frames at 640×480).
+  // 0.5 px; 640×480 frames under the stress levels measure ≤ 0.5 of the dot,
+  // 320×240 ones 0.4–0.75.
   float max_blur_to_dot = 0.75f;
 };
 

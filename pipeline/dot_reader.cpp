@@ -15,7 +15,8 @@
 // shortens least in relative terms.
 //
 // Read_Dots. A slot holds a dot when its brightness, sampled bilinearly on
-// the dot's core, falls below `dot_threshold_ratio` of the rectangle's own
+// the dot's core, falls below a threshold ratio (raised with blur) of the
+// rectangle's own
 // brightness, measured the same way half-way between slots where no dot is
 // ever printed. Brightness is taken both as the brightest channel and as
 // luma, and the lower ratio counts (see brightness_at). A ratio of
@@ -108,8 +109,18 @@ MarkerFrame marker_frame(const RectangleCandidate& red, const RectangleCandidate
   return m;
 }
 
+float dot_threshold_ratio(const DetectorParams& params, double blur_px, double red_dot_px) {
+  if (blur_px < 0.0 || red_dot_px <= 0.0) return params.dot_threshold_ratio;
+  const double span = params.blur_shift_full - params.blur_shift_start;
+  const double x =
+      std::hypot(blur_px, params.sampling_blur_px) / red_dot_px - params.blur_shift_start;
+  const double f = span > 0.0 ? std::clamp(x / span, 0.0, 1.0) : (x >= 0.0 ? 1.0 : 0.0);
+  return params.dot_threshold_ratio + static_cast<float>(f) * params.dot_threshold_blur_shift;
+}
+
 CodeReading read_code(const ImageView& frame, const MarkerFrame& marker, bool red,
-                      const CeilingLayout& layout, const DetectorParams& params) {
+                      const CeilingLayout& layout, const DetectorParams& params,
+                      float threshold_ratio) {
   CodeReading out;
   const double e_m = red ? layout.red_centre_e_m() : layout.green_centre_e_m();
   const double dot_e_m = red ? layout.red_dot_e_m : layout.green_dot_e_m;
@@ -156,8 +167,8 @@ CodeReading read_code(const ImageView& frame, const MarkerFrame& marker, bool re
       ratio = ratio < 0.0 ? r : std::min(ratio, r);
     }
     out.ratio[k] = static_cast<float>(ratio);
-    if (ratio < params.dot_threshold_ratio) code |= 1 << (layout.bits - 1 - k);
-    margin = std::min(margin, std::abs(ratio - params.dot_threshold_ratio));
+    if (ratio < threshold_ratio) code |= 1 << (layout.bits - 1 - k);
+    margin = std::min(margin, std::abs(ratio - threshold_ratio));
   }
   out.ok = true;
   out.code = code;

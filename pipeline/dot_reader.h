@@ -35,10 +35,18 @@ struct CodeReading {
   std::array<float, kMaxBits> ratio{};  // slot brightness / rectangle brightness, MSB first
 };
 
+// The dot threshold for a marker whose red rectangle's ends spread
+// `blur_px` (edge_spread_px; negative: unmeasured, taken as sharp) with red
+// dots `red_dot_px` tall: params.dot_threshold_ratio raised with the blur
+// (see DetectorParams::dot_threshold_blur_shift).
+float dot_threshold_ratio(const DetectorParams& params, double blur_px, double red_dot_px);
+
 // Reads the `layout.bits` slots of the red (x code) or green (y code)
-// rectangle. Sparse reads of the original frame: no allocation.
+// rectangle against `threshold_ratio` (dot_threshold_ratio()). Sparse reads
+// of the original frame: no allocation.
 CodeReading read_code(const ImageView& frame, const MarkerFrame& marker, bool red,
-                      const CeilingLayout& layout, const DetectorParams& params);
+                      const CeilingLayout& layout, const DetectorParams& params,
+                      float threshold_ratio);
 
 // Blur along North at the rectangle's two short ends, in pixels: the
 // distance over which the darkest channel climbs from 25 % to 75 % of the

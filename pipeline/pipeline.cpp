@@ -83,16 +83,20 @@ bool Pipeline::decode(const ImageView& frame, const MarkerPair& pair, MarkerObse
   }
   const CeilingLayout& layout = config_.layout;
   const MarkerFrame m = marker_frame(red, green, layout);
-  const CodeReading code_i = read_code(frame, m, true, layout, config_.detector);
-  const CodeReading code_j = read_code(frame, m, false, layout, config_.detector);
-  if (!code_i.ok || !code_j.ok) {
-    ++counters_.unreadable_codes;
-    return false;
-  }
+  // Blur first: it decides whether the dots can be read and where their
+  // threshold lies.
   const double px_per_m = std::hypot(m.north_u, m.north_v);
   const double red_dot_px = layout.red_dot_n_m * px_per_m;
-  if (edge_spread_px(frame, m, true, layout) > config_.detector.max_blur_to_dot * red_dot_px) {
+  const double blur_px = edge_spread_px(frame, m, true, layout);
+  if (blur_px > config_.detector.max_blur_to_dot * red_dot_px) {
     ++counters_.blurred_markers;
+    return false;
+  }
+  const float threshold = dot_threshold_ratio(config_.detector, blur_px, red_dot_px);
+  const CodeReading code_i = read_code(frame, m, true, layout, config_.detector, threshold);
+  const CodeReading code_j = read_code(frame, m, false, layout, config_.detector, threshold);
+  if (!code_i.ok || !code_j.ok) {
+    ++counters_.unreadable_codes;
     return false;
   }
   if (std::min(code_i.margin, code_j.margin) < config_.detector.dot_min_margin) {

@@ -4,7 +4,9 @@
 // and what the pipeline's own pose (auto mode) makes of them.
 //   ninja -C build detect_eval && build/bench/pipeline/detect_eval stress 200
 // Options by environment: WIDTH (320/640/1280, field of view kept), K1
-// (radial distortion k1, with k2 = 0.1·k1, in both renderer and pipeline).
+// (radial distortion k1, with k2 = 0.1·k1, in both renderer and pipeline),
+// SEED (scenario seed, default 7), DUMP=1 (per wrongly decoded marker: frame,
+// effects, codes, slot ratios, and what the frame's pose made of it).
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -12,6 +14,7 @@
 #include <string>
 #include <vector>
 
+#include "pipeline/dot_reader.h"
 #include "pipeline/pipeline.h"
 #include "sim/renderer.h"
 #include "sim/scenarios.h"
@@ -19,6 +22,66 @@
 
 namespace ceilpose {
 namespace {
+
+// The marker whose projected centre is nearest (u, v): the truth behind a
+// decoded marker.
+void nearest_marker(const PipelineConfig& config, const CameraPose& camera, double u, double v,
+                    int* i_out, int* j_out, double* err_px) {
+  *err_px = 1e9;
+  for (int i = 0; i < config.layout.codes(); ++i) {
+    for (int j = 0; j < config.layout.codes(); ++j) {
+      double pu = 0.0, pv = 0.0;
+      if (!project_world_point(config.intrinsics, camera, config.layout.marker_centre_w(i, j), &pu,
+                               &pv))
+        continue;
+      const double e = std::hypot(pu - u, pv - v);
+      if (e < *err_px) *err_px = e, *i_out = i, *j_out = j;
+    }
+  }
+}
+
+// One line for a wrongly decoded marker, with the slot ratios of its pair.
+void dump_wrong(const Pipeline& pipeline, const ImageView& image, const sim::ScenarioFrame& f,
+                size_t frame_index, const CameraPose& camera, const MarkerObservation& o,
+                const FrameResult& result) {
+  const PipelineConfig& config = pipeline.config();
+  int ti = -1, tj = -1;
+  double err_px = 0.0;
+  nearest_marker(config, camera, o.centre_u_px, o.centre_v_px, &ti, &tj, &err_px);
+  std::printf(
+      "WRONG frame %zu seed %llu | defocus %.2f motion %.2f px gain %.2f | read (%d,%d) true "
+      "(%d,%d) at %.1f px | centre (%.1f, %.1f) | markers %d valid %d pose error %.3f m\n",
+      frame_index, static_cast<unsigned long long>(f.seed), f.effects.defocus_sigma_px,
+      f.effects.motion_blur_px, f.effects.gain, o.code_i, o.code_j, ti, tj, err_px, o.centre_u_px,
+      o.centre_v_px, result.marker_count, result.estimate.valid ? 1 : 0,
+      std::hypot(result.estimate.pose.x_m - f.pose.x_m, result.estimate.pose.y_m - f.pose.y_m));
+  const auto rects = pipeline.rectangles();
+  for (const MarkerPair& p : pipeline.pairs()) {
+    const MarkerFrame m = marker_frame(rects[p.red], rects[p.green], config.layout);
+    if (std::hypot(m.centre_u_px - o.centre_u_px, m.centre_v_px - o.centre_v_px) > 1e-6) continue;
+    const double px_per_m = std::hypot(m.north_u, m.north_v);
+    const double red_dot_px = config.layout.red_dot_n_m * px_per_m;
+    const double blur_px = edge_spread_px(image, m, true, config.layout);
+    const float threshold = dot_threshold_ratio(config.detector, blur_px, red_dot_px);
+    std::printf(
+        "  px/m %.1f red dot %.2f px blur %.2f px threshold %.3f | red area %.0f long %.1f "
+        "dark %.0f | green area %.0f long %.1f dark %.0f\n",
+        px_per_m, red_dot_px, blur_px, threshold, rects[p.red].area_px, rects[p.red].long_px,
+        rects[p.red].dark_px, rects[p.green].area_px, rects[p.green].long_px,
+        rects[p.green].dark_px);
+    for (bool red : {true, false}) {
+      const CodeReading c = read_code(image, m, red, config.layout, config.detector, threshold);
+      std::printf("  %s code %d margin %.3f ratios", red ? "red  " : "green", c.code, c.margin);
+      for (int k = 0; k < config.layout.bits; ++k) std::printf(" %.3f", c.ratio[k]);
+      std::printf("\n");
+    }
+  }
+  for (int k = 0; k < result.marker_count; ++k) {
+    const MarkerObservation& q = result.markers[k];
+    std::printf("  decoded (%d,%d) at (%.1f, %.1f) quality %.2f\n", q.code_i, q.code_j,
+                q.centre_u_px, q.centre_v_px, q.quality);
+  }
+}
 
 double percentile(std::vector<double> v, double p) {
   if (v.empty()) return 0.0;
@@ -42,7 +105,9 @@ int run(const std::string& name, int frame_count) {
     options.intrinsics.distortion[1] = 0.1 * std::atof(k1);
   }
   sim::Renderer renderer(options);
-  const Result<sim::Scenario> scenario = sim::make_scenario(name, options, frame_count, 7);
+  const Result<sim::Scenario> scenario =
+      sim::make_scenario(name, options, frame_count,
+                         std::getenv("SEED") ? std::strtoull(std::getenv("SEED"), nullptr, 10) : 7);
   if (!scenario) {
     std::fprintf(stderr, "detect_eval: %s\n", scenario.error().message.c_str());
     return 2;
@@ -54,7 +119,9 @@ int run(const std::string& name, int frame_count) {
   Image image;
   int whole = 0, found = 0, wrong = 0, frames_with_whole = 0, valid = 0, gross = 0;
   std::vector<double> centre_err_px, pose_err_m;
-  for (const sim::ScenarioFrame& f : scenario->frames) {
+  const bool dump = std::getenv("DUMP") != nullptr;
+  for (size_t index = 0; index < scenario->frames.size(); ++index) {
+    const sim::ScenarioFrame& f = scenario->frames[index];
     renderer.render(f.pose, f.mount, f.effects, f.seed, &image);
     pipeline.process(image.view(), PositioningMode::kAuto, &result);
     const CameraPose camera = camera_pose_from_robot(f.pose, f.mount);
@@ -70,6 +137,7 @@ int run(const std::string& name, int frame_count) {
       const double err = std::hypot(o.centre_u_px - u, o.centre_v_px - v);
       if (err > 3.0) {
         ++wrong;
+        if (dump) dump_wrong(pipeline, image.view(), f, index, camera, o, result);
         continue;
       }
       ++right;

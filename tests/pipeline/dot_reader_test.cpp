@@ -57,8 +57,10 @@ TEST_F(DotReaderTest, EveryCodeReadsBackMsbNorthernmost) {
       m.west_image_rad = 0.3;
       const Image image = test::render_markers(320, 240, std::span(&m, 1), layout);
       const MarkerFrame f = frame_of(m, layout);
-      const CodeReading ci = read_code(image.view(), f, true, layout, params);
-      const CodeReading cj = read_code(image.view(), f, false, layout, params);
+      const CodeReading ci =
+          read_code(image.view(), f, true, layout, params, params.dot_threshold_ratio);
+      const CodeReading cj =
+          read_code(image.view(), f, false, layout, params, params.dot_threshold_ratio);
       ASSERT_TRUE(ci.ok && cj.ok);
       EXPECT_EQ(ci.code, i) << i << "," << j;
       EXPECT_EQ(cj.code, j) << i << "," << j;
@@ -74,7 +76,8 @@ TEST_F(DotReaderTest, SingleDotInTheNorthSlotIsTheMostSignificantBit) {
   m.code_i = 4;  // 100: only the northernmost slot
   m.code_j = 1;  // 001: only the southernmost
   const Image image = test::render_markers(320, 240, std::span(&m, 1), layout);
-  const CodeReading ci = read_code(image.view(), frame_of(m, layout), true, layout, params);
+  const CodeReading ci = read_code(image.view(), frame_of(m, layout), true, layout, params,
+                                   params.dot_threshold_ratio);
   ASSERT_TRUE(ci.ok);
   EXPECT_LT(ci.ratio[0], 0.5f);
   EXPECT_GT(ci.ratio[1], 0.9f);
@@ -86,7 +89,9 @@ TEST_F(DotReaderTest, MarkerReachingOutOfTheFrameIsNotRead) {
   m.centre_u_px = 10.0;
   m.centre_v_px = 120.0;
   const Image image = test::render_markers(320, 240, std::span(&m, 1), layout);
-  EXPECT_FALSE(read_code(image.view(), frame_of(m, layout), false, layout, params).ok);
+  EXPECT_FALSE(read_code(image.view(), frame_of(m, layout), false, layout, params,
+                         params.dot_threshold_ratio)
+                   .ok);
 }
 
 TEST_F(DotReaderTest, EdgeSpreadGrowsWithBlurAlongNorth) {
@@ -101,6 +106,24 @@ TEST_F(DotReaderTest, EdgeSpreadGrowsWithBlurAlongNorth) {
   const double blurred_px = edge_spread_px(test::blur_rows(sharp, 7).view(), f, true, layout);
   EXPECT_GT(blurred_px, 2.5);
   EXPECT_LT(blurred_px, 5.0);
+}
+
+TEST_F(DotReaderTest, DotThresholdRisesWithBlurRelativeToTheDot) {
+  const DetectorParams d;
+  const double dot_px = 6.0;
+  // Sharp, and unmeasured blur: the nominal threshold.
+  EXPECT_FLOAT_EQ(dot_threshold_ratio(d, 0.5, dot_px), d.dot_threshold_ratio);
+  EXPECT_FLOAT_EQ(dot_threshold_ratio(d, -1.0, dot_px), d.dot_threshold_ratio);
+  // Blur of most of the dot's height: fully raised, and never beyond.
+  const float full = d.dot_threshold_ratio + d.dot_threshold_blur_shift;
+  EXPECT_FLOAT_EQ(dot_threshold_ratio(d, d.blur_shift_full * dot_px, dot_px), full);
+  EXPECT_FLOAT_EQ(dot_threshold_ratio(d, 3.0 * dot_px, dot_px), full);
+  // In between it rises steadily; the same blur weighs more on a smaller dot.
+  const double mid_px = 0.5 * (d.blur_shift_start + d.blur_shift_full) * dot_px;
+  const float mid = dot_threshold_ratio(d, mid_px, dot_px);
+  EXPECT_GT(mid, d.dot_threshold_ratio);
+  EXPECT_LT(mid, full);
+  EXPECT_GT(dot_threshold_ratio(d, mid_px, 0.9 * dot_px), mid);
 }
 
 TEST_F(DotReaderTest, DarkAreaBeyondTheCodesDotsIsInconsistent) {
