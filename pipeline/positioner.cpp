@@ -6,6 +6,16 @@
 #include "pipeline/grid_consistency.h"
 
 namespace ceilpose {
+namespace {
+
+// A lone marker has no other to check its code against, and a misread one
+// puts the pose whole grid units off. Its dots must read clearly: quality
+// 0.5 is a slot margin of 0.15 from the dot threshold with a good pairing.
+// On the simulator at 320×240 every wrong code that reached a pose (before
+// the threshold followed blur) had a margin of 0.10–0.15.
+constexpr float kLoneMarkerMinQuality = 0.5f;
+
+}  // namespace
 
 Positioner::Positioner(const PipelineConfig& config) : params_(config.positioning), view_(config) {}
 
@@ -79,6 +89,7 @@ PoseEstimate Positioner::solve(std::span<const MarkerObservation> markers, Posit
     if (!markers[k].whole) continue;
     if (marker_fix(view_, markers[k], k, &fixes_[fix_count])) ++fix_count;
   }
+  if (fix_count == 1 && markers[fixes_[0].index].quality < kLoneMarkerMinQuality) return {};
   // 2. Keep the markers that agree on where the camera is.
   const int inliers =
       grid_consistent_subset(params_, view_.layout().grid_m, std::span(fixes_.data(), fix_count),

@@ -10,6 +10,7 @@
 #include "pipeline/pipeline.h"
 #include "tests/pipeline/detect_alloc_support.h"
 #include "tests/pipeline/detect_scene_support.h"
+#include "tests/pipeline/positioning_support.h"
 
 namespace ceilpose {
 namespace {
@@ -211,6 +212,27 @@ TEST_F(PipelineDetectTest, MarkerBlurredBeyondItsRedDotsIsRefusedNotMisread) {
   half.process(blurred.view(), PositioningMode::kAuto, &result);
   EXPECT_EQ(result.marker_count, 0);
   EXPECT_EQ(half.counters().blurred_markers, 1u);
+}
+
+TEST_F(PipelineDetectTest, LoneMarkerGivesAPoseOnlyWhenItsDotsReadClearly) {
+  // With no other marker to check its code against, a lone marker whose
+  // slots read close to the dot threshold (low quality) gives no pose; the
+  // same marker among others that agree with it still counts.
+  testing::SyntheticView view;
+  view.intrinsics = config.intrinsics;
+  view.mount = config.mount;
+  view.layout = config.layout;
+  std::vector<MarkerObservation> all = testing::observe(view, Pose2D{1.5, 2.1, 0.3});
+  ASSERT_GE(all.size(), 3u);
+  Positioner positioner(config);
+  std::vector<MarkerObservation> lone{all[0]};
+  lone[0].quality = 0.9f;
+  EXPECT_TRUE(positioner.solve(lone, PositioningMode::kChangeOfAxes).valid);
+  lone[0].quality = 0.3f;
+  EXPECT_FALSE(positioner.solve(lone, PositioningMode::kChangeOfAxes).valid);
+  EXPECT_FALSE(positioner.solve(lone, PositioningMode::kAuto).valid);
+  all[0].quality = 0.3f;
+  EXPECT_TRUE(positioner.solve(all, PositioningMode::kAuto).valid);
 }
 
 TEST_F(PipelineDetectTest, ProcessAllocatesNothing) {
