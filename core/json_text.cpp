@@ -1,5 +1,6 @@
 #include "core/json_text.h"
 
+#include <cmath>
 #include <cstdio>
 
 namespace ceilpose {
@@ -33,6 +34,14 @@ std::string json_quote(std::string_view text) {
     }
   }
   return out + "\"";
+}
+
+double printable_yaw_rad(double yaw_rad, int decimals) {
+  if (!std::isfinite(yaw_rad)) return yaw_rad;
+  const double scale = std::pow(10.0, decimals);
+  const double printed = std::round(yaw_rad * scale) / scale;
+  if (printed > M_PI || printed <= -M_PI) return std::floor(M_PI * scale) / scale;
+  return yaw_rad;
 }
 
 }  // namespace ceilpose

@@ -9,4 +9,10 @@ namespace ceilpose {
 // `text` as a JSON string literal, with its quotes; control characters escaped.
 std::string json_quote(std::string_view text);
 
+// The value to print with `decimals` decimals (printf "%.*f") so that the
+// printed number, read back, still lies in SPEC §1's (−π, π]: plain rounding
+// turns a yaw within half a last digit of ±π into 3.1415927 or −3.1415927
+// (7 decimals), both outside. Those print as the largest decimal below π.
+double printable_yaw_rad(double yaw_rad, int decimals);
+
 }  // namespace ceilpose

@@ -48,7 +48,7 @@ void print_json(const FleetArgs& args, const std::vector<FleetRobot>& robots, in
     if (r.samples > 0) {
       out += ",\"x_m\":" + json_number(r.latest.pose.x_m) +
              ",\"y_m\":" + json_number(r.latest.pose.y_m) +
-             ",\"yaw_rad\":" + json_number(r.latest.pose.yaw_rad) +
+             ",\"yaw_rad\":" + json_number(printable_yaw_rad(r.latest.pose.yaw_rad, 6)) +
              ",\"stamp_ns\":" + std::to_string(r.latest.capture_realtime_ns) +
              ",\"age_ms\":" + std::to_string(age_ms(r, now_ns));
     } else {

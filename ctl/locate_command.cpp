@@ -3,6 +3,7 @@
 #include <cinttypes>
 #include <cstdio>
 
+#include "core/json_text.h"
 #include "ctl/command_registry.h"
 #include "ctl/replay_localizer.h"
 
@@ -20,10 +21,11 @@ void print_frame(const ReplayFrame& f, PositioningMode requested) {
                 ",\"valid\":true,\"x_m\":%.7f,\"y_m\":%.7f,\"yaw_rad\":%.7f,\"mode\":\"%.*s\","
                 "\"markers\":%d,\"proc_us\":%" PRId64
                 ",\"rms_px\":%.3f,\"cov\":[%.3e,%.3e,%.3e,%.3e,%.3e,%.3e]}\n",
-                f.row->index, f.row->timestamp_ns, e.pose.x_m, e.pose.y_m, e.pose.yaw_rad,
-                static_cast<int>(mode.size()), mode.data(), e.markers, (f.proc_ns + 500) / 1000,
-                e.rms_residual_px, e.covariance[0], e.covariance[1], e.covariance[2],
-                e.covariance[4], e.covariance[5], e.covariance[8]);
+                f.row->index, f.row->timestamp_ns, e.pose.x_m, e.pose.y_m,
+                printable_yaw_rad(e.pose.yaw_rad, 7), static_cast<int>(mode.size()), mode.data(),
+                e.markers, (f.proc_ns + 500) / 1000, e.rms_residual_px, e.covariance[0],
+                e.covariance[1], e.covariance[2], e.covariance[4], e.covariance[5],
+                e.covariance[8]);
   } else {
     std::printf("{\"index\":%" PRId64 ",\"timestamp_ns\":%" PRId64
                 ",\"valid\":false,\"x_m\":null,\"y_m\":null,\"yaw_rad\":null,\"mode\":\"%.*s\","

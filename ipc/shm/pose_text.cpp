@@ -4,6 +4,8 @@
 #include <cstdio>
 #include <numbers>
 
+#include "core/json_text.h"
+
 namespace ceilpose {
 
 namespace {
@@ -27,7 +29,8 @@ std::string pose_json(const PoseRecord& p, int64_t now_mono_ns, const std::strin
   const bool valid = pose_is_valid(p);
   std::string out = format("{\"seq\":%" PRIu64 ",\"valid\":%s", p.seq, valid ? "true" : "false");
   if (valid) {
-    out += format(",\"x_m\":%.7f,\"y_m\":%.7f,\"yaw_rad\":%.7f", p.x_m, p.y_m, p.yaw_rad);
+    out += format(",\"x_m\":%.7f,\"y_m\":%.7f,\"yaw_rad\":%.7f", p.x_m, p.y_m,
+                  printable_yaw_rad(p.yaw_rad, 7));
   } else {
     out += ",\"x_m\":null,\"y_m\":null,\"yaw_rad\":null";
   }
