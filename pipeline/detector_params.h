@@ -114,7 +114,7 @@ struct DetectorParams {
   // dot's height in pixels: such blur can wash a 1 in dot out completely,
   // and an unset slot then looks confidently unset. Sharp edges spread
   // 0.5 px; 640×480 frames under the stress levels measure ≤ 0.5 of the dot,
-  // 320×240 ones 0.4–0.75.
+  // 320×240 ones mostly 0.4–0.7.
   float max_blur_to_dot = 0.75f;
 };
 

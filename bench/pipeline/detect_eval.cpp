@@ -6,7 +6,9 @@
 // Options by environment: WIDTH (320/640/1280, field of view kept), K1
 // (radial distortion k1, with k2 = 0.1·k1, in both renderer and pipeline),
 // SEED (scenario seed, default 7), DUMP=1 (per wrongly decoded marker: frame,
-// effects, codes, slot ratios, and what the frame's pose made of it).
+// effects, codes, slot ratios, and what the frame's pose made of it), SLOTS=1
+// (the highest ratio a printed red dot read and the lowest an empty slot
+// read, over every pair within 3 px of a true marker, decoded or not).
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -83,6 +85,35 @@ void dump_wrong(const Pipeline& pipeline, const ImageView& image, const sim::Sce
   }
 }
 
+// Extremes of the slot ratios against the truth, for choosing thresholds.
+struct SlotExtremes {
+  double red_dot_max = 0.0, empty_min = 1e9;
+  void add(const Pipeline& pipeline, const ImageView& image, const CameraPose& camera) {
+    const PipelineConfig& config = pipeline.config();
+    const auto rects = pipeline.rectangles();
+    for (const MarkerPair& p : pipeline.pairs()) {
+      if (rects[p.red].touches_border || rects[p.green].touches_border) continue;
+      const MarkerFrame m = marker_frame(rects[p.red], rects[p.green], config.layout);
+      int truth[2] = {-1, -1};
+      double err_px = 0.0;
+      nearest_marker(config, camera, m.centre_u_px, m.centre_v_px, &truth[0], &truth[1], &err_px);
+      if (err_px > 3.0) continue;
+      for (int c = 0; c < 2; ++c) {
+        const CodeReading r = read_code(image, m, c == 0, config.layout, config.detector,
+                                        config.detector.dot_threshold_ratio);
+        if (!r.ok) continue;
+        for (int k = 0; k < config.layout.bits; ++k) {
+          if (!config.layout.slot_bit(truth[c], k)) {
+            empty_min = std::min(empty_min, static_cast<double>(r.ratio[k]));
+          } else if (c == 0) {
+            red_dot_max = std::max(red_dot_max, static_cast<double>(r.ratio[k]));
+          }
+        }
+      }
+    }
+  }
+};
+
 double percentile(std::vector<double> v, double p) {
   if (v.empty()) return 0.0;
   std::sort(v.begin(), v.end());
@@ -120,11 +151,14 @@ int run(const std::string& name, int frame_count) {
   int whole = 0, found = 0, wrong = 0, frames_with_whole = 0, valid = 0, gross = 0;
   std::vector<double> centre_err_px, pose_err_m;
   const bool dump = std::getenv("DUMP") != nullptr;
+  const bool slots = std::getenv("SLOTS") != nullptr;
+  SlotExtremes extremes;
   for (size_t index = 0; index < scenario->frames.size(); ++index) {
     const sim::ScenarioFrame& f = scenario->frames[index];
     renderer.render(f.pose, f.mount, f.effects, f.seed, &image);
     pipeline.process(image.view(), PositioningMode::kAuto, &result);
     const CameraPose camera = camera_pose_from_robot(f.pose, f.mount);
+    if (slots) extremes.add(pipeline, image.view(), camera);
     const int in_view = sim::count_whole_markers(options, f.pose, f.mount);
     whole += in_view;
     frames_with_whole += in_view > 0 ? 1 : 0;
@@ -163,6 +197,10 @@ int run(const std::string& name, int frame_count) {
       gross, static_cast<unsigned long>(c.cut_markers),
       static_cast<unsigned long>(c.blurred_markers), static_cast<unsigned long>(c.ambiguous_codes),
       static_cast<unsigned long>(c.inconsistent_markers));
+  if (slots) {
+    std::printf("slot ratios: printed red dots up to %.3f, empty slots down to %.3f\n",
+                extremes.red_dot_max, extremes.empty_min);
+  }
   return 0;
 }
 
