@@ -210,6 +210,8 @@ Spec6Figures score(const LocateCase& c, const std::vector<XPose>& truth, const L
   Spec6Figures f;
   f.yaw_slack_rad = 0.5e-7;  // locate prints yaw_rad with 7 decimals
   EXPECT_EQ(run.exit_code, 0) << c.name << ": " << run.stderr_text;
+  // stderr is no terminal: no progress line, and nothing else (nor a sanitizer report).
+  EXPECT_EQ(run.stderr_text, "") << c.name;
   EXPECT_EQ(run.lines.size(), truth.size()) << c.name << ": " << run.stderr_text;
   for (size_t k = 0; k < truth.size() && k < run.lines.size(); ++k) {
     const std::string& line = run.lines[k];
@@ -394,6 +396,7 @@ TEST(IndependentLocateGrey, GreyscalePngRecordingGivesNoPoseOnAnyFrame) {
     ASSERT_EQ(first.channels(), 1) << "the frames must really be greyscale PNG";
     const LocateOutput run = run_locate(recording, fs::path(), scratch.path());
     ASSERT_EQ(run.exit_code, 0) << run.stderr_text;
+    EXPECT_EQ(run.stderr_text, "") << c.name;
     ASSERT_EQ(run.lines.size(), truth.size()) << run.stderr_text;
     for (const std::string& line : run.lines) {
       EXPECT_NE(line.find("\"valid\":false,\"x_m\":null,\"y_m\":null,\"yaw_rad\":null"),
