@@ -208,7 +208,6 @@ fs::path write_height_config(const XMount& mount, const fs::path& dir) {
 // for index order and a yaw in (-pi, pi].
 Spec6Figures score(const LocateCase& c, const std::vector<XPose>& truth, const LocateOutput& run) {
   Spec6Figures f;
-  f.yaw_slack_rad = 0.5e-7;  // locate prints yaw_rad with 7 decimals
   EXPECT_EQ(run.exit_code, 0) << c.name << ": " << run.stderr_text;
   // stderr is no terminal: no progress line, and nothing else (nor a sanitizer report).
   EXPECT_EQ(run.stderr_text, "") << c.name;

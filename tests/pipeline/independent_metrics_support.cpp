@@ -35,8 +35,8 @@ void Spec6Figures::add(const XPose& truth, bool whole_marker_in_view,
   const double dyaw_deg =
       std::abs(wrapped_rad(reported->yaw_rad - truth.yaw_rad)) * 180.0 / std::numbers::pi;
   const double err_m = std::hypot(dx_m, dy_m);
-  yaw_out_of_range += !(reported->yaw_rad > -std::numbers::pi - yaw_slack_rad &&
-                        reported->yaw_rad <= std::numbers::pi + yaw_slack_rad);
+  yaw_out_of_range +=
+      !(reported->yaw_rad > -std::numbers::pi && reported->yaw_rad <= std::numbers::pi);
   within_both += std::abs(dx_m) <= 0.05 * kGridUnit_m && std::abs(dy_m) <= 0.05 * kGridUnit_m;
   gross += err_m > 0.25 * kGridUnit_m || dyaw_deg > 5.0;
   error_mm.push_back(err_m * 1000.0);

@@ -38,10 +38,6 @@ struct Spec6Figures {
   // Signed error in the robot frame: a bent pixel or axis convention shows as a bias.
   double sum_forward_mm = 0.0;
   double sum_left_mm = 0.0;
-  // How far beyond (-pi, pi] a reported yaw may lie and still count as in
-  // range: 0 for poses taken from the pipeline, the print resolution for
-  // poses parsed from text (a yaw of pi printed to 7 decimals reads 3.1415927).
-  double yaw_slack_rad = 0.0;
 
   // One frame: the truth, whether a whole marker was in view, and the
   // reported pose (nullopt when the frame gave none).
