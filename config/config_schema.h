@@ -123,6 +123,10 @@ void describe(V& v, ServiceConfig& c) {
     v.field("dot_threshold_ratio", d.dot_threshold_ratio, 0.0f, 1.0f);
     v.field("dot_search_m", d.dot_search_m, 0.0, 1.0);
     v.field("dot_min_margin", d.dot_min_margin, 0.0f, 1.0f);
+    v.field("dot_threshold_blur_shift", d.dot_threshold_blur_shift, 0.0f, 1.0f);
+    v.field("blur_shift_start", d.blur_shift_start, 0.0f, 100.0f);
+    v.field("blur_shift_full", d.blur_shift_full, 0.0f, 100.0f);
+    v.field("sampling_blur_px", d.sampling_blur_px, 0.0f, 100.0f);
     v.field("max_blur_to_dot", d.max_blur_to_dot, 0.0f, 100.0f);
   });
   v.section("positioning", [&] {
