@@ -1,6 +1,7 @@
 #include "pipeline/color_classifier.h"
 
 #include <cmath>
+#include <cstdlib>
 
 // Method (issue 3, "thresholds that adapt to exposure and white balance").
 //
@@ -9,12 +10,26 @@
 // is first normalised so that its ceiling tile reads as the nominal tile
 // colour, and only then classified with fixed HSV-style rules:
 //
-//  1. White reference. A sparse grid (every `white_sample_step_px`-th pixel
-//     of every step-th row, ≈ 1/256 of the frame) is read. Samples that are
-//     neither dark (max < 40) nor colourful (HSV saturation > 0.35) are
-//     tile, rails or fixtures; the tile covers most of any ceiling view, so
-//     the median brightness of those samples is tile, and the mean R, G, B
-//     of the samples within ±15 % of that median is the tile reference.
+//  1. White reference, from this frame alone. A sparse grid (every
+//     `white_sample_step_px`-th pixel of every step-th row, ≈ 1/256 of the
+//     frame) is read. Samples that are neither dark (max < 40) nor clearly
+//     marker-coloured (HSV saturation > 0.6) may be tile, rails, fixtures or
+//     clutter; the tile covers most of any ceiling view, so the median of
+//     their mean level (r + g + b) / 3 is tile. Within ±15 % of it, the
+//     tile's chromaticity r / (r + g + b), b / (r + g + b) is the median of
+//     those samples, and the mean R, G, B of the samples within ±10/255 of
+//     it in both is the tile reference. The saturation cut is loose because
+//     a cast saturates the tile itself: (1.35, 1, 0.65) on sRGB levels makes
+//     it (255, 215, 133), saturation 0.48, while the printed red and green
+//     stay above 0.66 under any cast up to ±35 % per channel (except green
+//     under magenta, 0.48, which is then half as bright as the tile). What
+//     the cut lets through is removed by the two windows: white fixtures
+//     read brighter (mean 255 against the tile's ≤ 212 at the same gain)
+//     and, under a cast, also have another chromaticity; clutter and
+//     rails have another level or chromaticity. Too few samples left (fewer
+//     than `white_min_share` of the grid) gives unit gains, never an
+//     earlier frame's, so the classification of a frame never depends on
+//     the frames before it (SPEC §5).
 //     A camera gain g or a channel cast w multiplies linear light, which is
 //     close to multiplying the 8-bit sRGB level by g^(1/2.2): one gain per
 //     channel, gain_c = tile_c / reference_c, undoes both.
@@ -36,8 +51,11 @@ namespace ceilpose {
 namespace {
 
 constexpr int kMinSampleLevel = 40;
-constexpr float kMaxTileSaturation = 0.35f;
+// Largest sample saturation (v - m) / v that may be tile: 3 / 5.
+constexpr int kMaxTileSaturationNum = 3;
+constexpr int kMaxTileSaturationDen = 5;
 constexpr float kTileWindow = 0.15f;
+constexpr int kTileChromaWindow = 10;
 constexpr float kMinGain = 0.25f;
 constexpr float kMaxGain = 4.0f;
 
@@ -53,6 +71,17 @@ float hue_deg(int r, int g, int b, int v, int m) {
     h = 240.0f + 60.0f * static_cast<float>(r - g) / d;
   }
   return h;
+}
+
+// Smallest bin at or below which half of the `total` counts lie.
+int median_bin(const std::array<uint32_t, 256>& count, uint32_t total) {
+  uint32_t seen = 0;
+  int bin = 0;
+  for (; bin < 255; ++bin) {
+    seen += count[bin];
+    if (2 * seen >= total) break;
+  }
+  return bin;
 }
 
 }  // namespace
@@ -95,6 +124,11 @@ void ColorClassifier::set_params(const DetectorParams& params, Rgb tile) {
         lut_[idx] = static_cast<uint8_t>(classify_normalised(
             qr * kStep + kStep / 2, qg * kStep + kStep / 2, qb * kStep + kStep / 2));
       }
+  // 255 / sum in 16 fractional bits: two chromaticities per tile sample
+  // without a division.
+  chroma_scale_[0] = 0;
+  for (int sum = 1; sum < static_cast<int>(chroma_scale_.size()); ++sum)
+    chroma_scale_[sum] = static_cast<uint32_t>((255u << 16) / static_cast<unsigned>(sum));
   set_gains(gains_);
 }
 
@@ -112,44 +146,85 @@ void ColorClassifier::set_gains(const std::array<float, 3>& gains) {
   }
 }
 
+void ColorClassifier::use_default_normalisation() {
+  reference_ = {static_cast<float>(tile_.r), static_cast<float>(tile_.g),
+                static_cast<float>(tile_.b)};
+  set_gains({1.0f, 1.0f, 1.0f});
+}
+
 bool ColorClassifier::adapt(const ImageView& frame) {
-  if (frame.empty() || frame.format == PixelFormat::kMjpeg) return false;
-  const int step = std::max(1, params_.white_sample_step_px);
+  if (frame.empty() || frame.format == PixelFormat::kMjpeg) {
+    use_default_normalisation();
+    return false;
+  }
+  // The grid's tile candidates are kept (packed) for the two later passes;
+  // frames with more grid points than the buffer holds (above ≈ 1920 × 1080
+  // at step 16) are sampled more coarsely.
+  int step = std::max(1, params_.white_sample_step_px);
+  while (static_cast<size_t>((frame.width + step - 1) / step) * ((frame.height + step - 1) / step) >
+         samples_.size())
+    ++step;
   std::array<uint32_t, 256> count{};
-  std::array<std::array<uint32_t, 256>, 3> sum{};
   uint32_t total = 0, candidates = 0;
-  for (int y = step / 2; y < frame.height; y += step) {
+  for (int y = step / 2; y < frame.height; y += step)
     for (int x = step / 2; x < frame.width; x += step) {
       uint8_t r = 0, g = 0, b = 0;
       read_rgb(frame, x, y, &r, &g, &b);
       ++total;
       const int v = std::max({r, g, b});
       const int m = std::min({r, g, b});
-      if (v < kMinSampleLevel) continue;
-      if (static_cast<float>(v - m) > kMaxTileSaturation * static_cast<float>(v)) continue;
-      ++count[v];
-      sum[0][v] += r;
-      sum[1][v] += g;
-      sum[2][v] += b;
-      ++candidates;
+      // Saturation (v - m) / v at most kMaxTileSaturationNum / Den.
+      if (v < kMinSampleLevel || (v - m) * kMaxTileSaturationDen > v * kMaxTileSaturationNum)
+        continue;
+      ++count[(r + g + b) / 3];
+      samples_[candidates++] =
+          static_cast<uint32_t>(r) | static_cast<uint32_t>(g) << 8 | static_cast<uint32_t>(b) << 16;
     }
+  if (total == 0 || static_cast<float>(candidates) < params_.white_min_share * total) {
+    use_default_normalisation();
+    return false;
   }
-  if (total == 0 || static_cast<float>(candidates) < params_.white_min_share * total) return false;
-  uint32_t seen = 0;
-  int median = 0;
-  for (; median < 255; ++median) {
-    seen += count[median];
-    if (2 * seen >= candidates) break;
-  }
-  const int lo = static_cast<int>(std::floor(median * (1.0f - kTileWindow)));
-  const int hi = std::min(255, static_cast<int>(std::ceil(median * (1.0f + kTileWindow))));
+  const int median = median_bin(count, candidates);
+  const int lo_sum = 3 * static_cast<int>(std::floor(median * (1.0f - kTileWindow)));
+  const int hi_sum = 3 * static_cast<int>(std::ceil(median * (1.0f + kTileWindow))) + 2;
+  // Visits the candidates within the tile's brightness window with their
+  // chromaticities c / (r + g + b) in 1/255 steps (r and b fix g).
+  const auto for_each_windowed = [&](auto&& visit) {
+    for (uint32_t k = 0; k < candidates; ++k) {
+      const int r = static_cast<int>(samples_[k] & 0xff);
+      const int g = static_cast<int>(samples_[k] >> 8 & 0xff);
+      const int b = static_cast<int>(samples_[k] >> 16);
+      const int sum = r + g + b;
+      if (sum < lo_sum || sum > hi_sum) continue;
+      const uint32_t scale = chroma_scale_[sum];
+      visit(r, g, b, static_cast<int>((static_cast<uint32_t>(r) * scale) >> 16),
+            static_cast<int>((static_cast<uint32_t>(b) * scale) >> 16));
+    }
+  };
+  std::array<std::array<uint32_t, 256>, 2> chroma_count{};
+  uint32_t windowed = 0;
+  for_each_windowed([&](int, int, int, int chroma_r, int chroma_b) {
+    ++chroma_count[0][chroma_r];
+    ++chroma_count[1][chroma_b];
+    ++windowed;
+  });
+  const int median_r = median_bin(chroma_count[0], windowed);
+  const int median_b = median_bin(chroma_count[1], windowed);
   std::array<double, 3> acc{};
-  double n = 0.0;
-  for (int v = lo; v <= hi; ++v) {
-    n += count[v];
-    for (int c = 0; c < 3; ++c) acc[c] += sum[c][v];
+  uint32_t n = 0;
+  for_each_windowed([&](int r, int g, int b, int chroma_r, int chroma_b) {
+    if (std::abs(chroma_r - median_r) > kTileChromaWindow ||
+        std::abs(chroma_b - median_b) > kTileChromaWindow)
+      return;
+    acc[0] += r;
+    acc[1] += g;
+    acc[2] += b;
+    ++n;
+  });
+  if (n == 0 || static_cast<float>(n) < params_.white_min_share * total) {
+    use_default_normalisation();
+    return false;
   }
-  if (n <= 0.0) return false;
   const std::array<float, 3> nominal{static_cast<float>(tile_.r), static_cast<float>(tile_.g),
                                      static_cast<float>(tile_.b)};
   std::array<float, 3> gains{};

@@ -63,8 +63,9 @@ class ColorClassifier {
   void set_params(const DetectorParams& params, Rgb tile);
 
   // Estimates the frame's tile reference from a sparse grid sample and sets
-  // the per-channel normalisation. Returns false when too few pixels looked
-  // like tile; the previous normalisation is then kept.
+  // the per-channel normalisation from this frame alone. Returns false when
+  // too few pixels looked like tile; the default normalisation (unit gains)
+  // is then used, never an earlier frame's.
   bool adapt(const ImageView& frame);
 
   // Normalisation tables: table(c)[level] is the channel's normalised,
@@ -87,12 +88,17 @@ class ColorClassifier {
   void set_gains(const std::array<float, 3>& gains);
 
  private:
+  void use_default_normalisation();
+
   DetectorParams params_;
   Rgb tile_{};
   std::vector<uint8_t> lut_;
   std::array<std::array<uint32_t, 256>, 3> tables_{};
   std::array<float, 3> gains_{1.0f, 1.0f, 1.0f};
   std::array<float, 3> reference_{};
+  std::array<uint32_t, 3 * 255 + 1> chroma_scale_{};
+  // Tile candidates of the current frame's sample grid, R | G << 8 | B << 16.
+  std::array<uint32_t, 8192> samples_{};
 };
 
 }  // namespace ceilpose

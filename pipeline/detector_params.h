@@ -37,7 +37,8 @@ struct DetectorParams {
   // width*height/step² pixel reads).
   int white_sample_step_px = 16;
   // Share of the sampled pixels that must look like tile for the estimate to
-  // be trusted; otherwise the previous frame's reference is kept (counted).
+  // be trusted; otherwise the frame is classified with unit gains (counted),
+  // never with an earlier frame's.
   float white_min_share = 0.05f;
 
   // --- connected components (components.cpp) ---

@@ -2,6 +2,7 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <vector>
 
 #include "tests/pipeline/detect_scene_support.h"
@@ -65,11 +66,86 @@ TEST_F(ColorClassifierTest, ColourCastIsNormalisedAwayByTheTileReference) {
   EXPECT_EQ(classifier.classify(r, g, b), PixelClass::kBackground);
 }
 
-TEST_F(ColorClassifierTest, AdaptKeepsThePreviousGainsOnAFrameWithoutTile) {
+// A cast given as sRGB-level gains, as Lighting's linear-light one.
+test::Lighting srgb_cast(double r, double g, double b) {
+  test::Lighting lighting;
+  lighting.cast = {std::pow(r, 2.2), std::pow(g, 2.2), std::pow(b, 2.2)};
+  return lighting;
+}
+
+Image marker_frame(const CeilingLayout& layout, const test::Lighting& lighting) {
+  test::CraftedMarker marker;
+  marker.centre_u_px = 160.0;
+  marker.centre_v_px = 120.0;
+  return test::render_markers(320, 240, std::span(&marker, 1), layout, lighting);
+}
+
+void fill(Image* image, int x0, int y0, int x1, int y1, Rgb colour) {
+  for (int y = y0; y < y1; ++y)
+    for (int x = x0; x < x1; ++x) test::put_rgb(image, x, y, colour);
+}
+
+std::vector<PixelClass> classes_of(const ColorClassifier& classifier, const Image& frame) {
+  std::vector<PixelClass> out;
+  for (int y = 0; y < frame.height(); ++y)
+    for (int x = 0; x < frame.width(); ++x) {
+      uint8_t r = 0, g = 0, b = 0;
+      read_rgb(frame.view(), x, y, &r, &g, &b);
+      out.push_back(classifier.classify(r, g, b));
+    }
+  return out;
+}
+
+TEST_F(ColorClassifierTest, StrongWarmCastWithFixtureAndClutterStillFindsTheTile) {
+  // (1.35, 1, 0.65) on sRGB levels: the tile reads (255, 215, 133),
+  // saturation 0.48. A clipped white fixture (mean 255) and red and green
+  // clutter beside the marker must not become the reference.
+  Image frame = marker_frame(layout, srgb_cast(1.35, 1.0, 0.65));
+  uint8_t tr = 0, tg = 0, tb = 0;
+  read_rgb(frame.view(), 5, 5, &tr, &tg, &tb);
+  fill(&frame, 240, 0, 320, 60, Rgb{255, 255, 255});
+  fill(&frame, 0, 180, 60, 240, Rgb{255, 40, 26});
+  fill(&frame, 250, 180, 320, 240, Rgb{54, 160, 45});
+  ASSERT_TRUE(classifier.adapt(frame.view()));
+  EXPECT_NEAR(classifier.reference()[0], tr, 3.0);
+  EXPECT_NEAR(classifier.reference()[1], tg, 3.0);
+  EXPECT_NEAR(classifier.reference()[2], tb, 3.0);
+  uint8_t r = 0, g = 0, b = 0;
+  read_rgb(frame.view(), 160, 120 - 15, &r, &g, &b);
+  EXPECT_EQ(classifier.classify(r, g, b), PixelClass::kRed);
+  read_rgb(frame.view(), 160, 120 + 15, &r, &g, &b);
+  EXPECT_EQ(classifier.classify(r, g, b), PixelClass::kGreen);
+  EXPECT_EQ(classifier.classify(tr, tg, tb), PixelClass::kBackground);
+}
+
+TEST_F(ColorClassifierTest, AFrameIsClassifiedAlikeWhateverFrameCameBefore) {
+  // SPEC §5: without filtering every frame is solved on its own, so the
+  // normalisation may not carry over from the previous frame, also when a
+  // frame has no tile to adapt to.
+  const Image warm = marker_frame(layout, srgb_cast(1.3, 1.0, 0.7));
+  const Image cool = marker_frame(layout, srgb_cast(0.7, 1.0, 1.3));
+  const Image black(320, 240, PixelFormat::kRgb24);
+  for (const Image* frame : {&warm, &cool, &black}) {
+    ColorClassifier fresh(params, layout.tile);
+    const bool adapted = fresh.adapt(frame->view());
+    EXPECT_EQ(adapted, frame != &black);
+    const std::vector<PixelClass> expected = classes_of(fresh, *frame);
+    for (const Image* before : {&warm, &cool, &black}) {
+      ColorClassifier after(params, layout.tile);
+      after.adapt(before->view());
+      EXPECT_EQ(after.adapt(frame->view()), adapted);
+      EXPECT_EQ(after.gains(), fresh.gains());
+      EXPECT_TRUE(classes_of(after, *frame) == expected);
+    }
+  }
+}
+
+TEST_F(ColorClassifierTest, AdaptFallsBackToUnitGainsOnAFrameWithoutTile) {
+  ASSERT_TRUE(classifier.adapt(marker_frame(layout, srgb_cast(1.3, 1.0, 0.7)).view()));
+  ASSERT_NE(classifier.gains(), (std::array<float, 3>{1.0f, 1.0f, 1.0f}));
   Image black(64, 48, PixelFormat::kRgb24);
-  const auto before = classifier.gains();
   EXPECT_FALSE(classifier.adapt(black.view()));
-  EXPECT_EQ(classifier.gains(), before);
+  EXPECT_EQ(classifier.gains(), (std::array<float, 3>{1.0f, 1.0f, 1.0f}));
 }
 
 TEST_F(ColorClassifierTest, YuyvReadsBackThePrintedColours) {

@@ -322,6 +322,12 @@ std::vector<LocateCase> locate_cases() {
   cast(add("WarmCast", 2303, 0.65, 0.02), {1.2, 1.0, 0.8}, 2.0);
   cast(add("CoolCast", 2304, 0.75, 0.02), {0.75, 1.0, 1.35}, 2.0);
   cast(add("MagentaCast", 2305, 0.75, 0.02), {1.2, 0.8, 1.2}, 2.0);
+  // Known failures until the tile-reference sample accepted a tile saturated
+  // by the cast (docs/cross_check.md).
+  cast(add("StrongWarmCast", 2303, 0.6, 0.02), {1.3, 1.0, 0.7}, 2.0);
+  LocateCase& warm_bare = add("StrongWarmCastNoFixtures", 2303, 0.6, 0.02);
+  cast(warm_bare, {1.3, 1.0, 0.7}, 2.0);
+  warm_bare.options.light_fixtures = false;
   LocateCase& wide = add("Wide1920x1080OffCentre", 2401, 0.3, 0.01);
   wide.camera = XCamera{1920, 1080, 1400.0, 1400.0, 959.5 + 20.0, 539.5 - 20.0, {}};
   wide.options.supersample = 3;
@@ -344,23 +350,6 @@ std::vector<LocateCase> locate_cases() {
   return cases;
 }
 
-// Cases the pipeline fails today (docs/cross_check.md, "Known failures");
-// run with --gtest_also_run_disabled_tests.
-std::vector<LocateCase> known_failures() {
-  std::vector<LocateCase> cases;
-  for (const bool fixtures : {true, false}) {
-    LocateCase& warm = cases.emplace_back();
-    warm.name = fixtures ? "StrongWarmCast" : "StrongWarmCastNoFixtures";
-    warm.seed = 2303;
-    warm.options.channel_gain = {1.3, 1.0, 0.7};
-    warm.options.noise_sigma = 2.0;
-    warm.options.light_fixtures = fixtures;
-    warm.max_error_mm = 1.0;
-    warm.max_yaw_deg = 0.02;
-  }
-  return cases;
-}
-
 std::string case_name(const ::testing::TestParamInfo<LocateCase>& info) {
   std::string name = info.param.name;
   for (char& ch : name) {
@@ -371,8 +360,6 @@ std::string case_name(const ::testing::TestParamInfo<LocateCase>& info) {
 
 INSTANTIATE_TEST_SUITE_P(Recordings, IndependentLocate, ::testing::ValuesIn(locate_cases()),
                          case_name);
-INSTANTIATE_TEST_SUITE_P(DISABLED_KnownFailures, IndependentLocate,
-                         ::testing::ValuesIn(known_failures()), case_name);
 
 // SPEC §4 allows greyscale PNG frames, but the markers are told apart by
 // colour: `locate` must read every frame, report no pose and exit 0.
