@@ -149,6 +149,7 @@ void describe(V& v, ServiceConfig& c) {
     v.field("lsq_estimate_height", q.lsq_estimate_height);
     v.field("grid_tolerance_units", q.grid_tolerance_units, 0.01, 0.5);
     v.field("heading_tolerance_rad", q.heading_tolerance_rad, 0.0, kPi);
+    v.field("max_depth_scale_error", q.max_depth_scale_error, 0.0, 1.0);
     v.field("barycentric_min_area_units2", q.barycentric_min_area_units2, 0.0, 100.0);
     v.field("thesis_sigma_m", q.thesis_sigma_m, 1e-6, 10.0);
     v.field("thesis_sigma_yaw_rad", q.thesis_sigma_yaw_rad, 1e-6, kPi);

@@ -5,11 +5,14 @@
 // only main.cpp, the registry and *_command.cpp.
 #include <unistd.h>
 
+#include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <functional>
 #include <optional>
 #include <string>
 #include <utility>
+#include <vector>
 
 #include "config/service_config.h"
 #include "core/clock.h"
@@ -91,6 +94,27 @@ struct ReplayFrame {
   int64_t proc_ns = 0;
 };
 
+// After a run: when the markers' spacing says the configured heights are
+// wrong, positioning refuses those frames (max_depth_scale_error), and a
+// user would otherwise see only "valid":false; say why, once.
+inline void warn_if_heights_disagree(const char* command, const PipelineConfig& config,
+                                     std::vector<double>* depth_scales) {
+  const double limit = config.positioning.max_depth_scale_error;
+  if (depth_scales->empty() || limit <= 0.0) return;
+  const auto mid = depth_scales->begin() + static_cast<ptrdiff_t>(depth_scales->size() / 2);
+  std::nth_element(depth_scales->begin(), mid, depth_scales->end());
+  const double scale = *mid;
+  if (std::fabs(scale - 1.0) <= limit / 2.0) return;
+  const double depth_m = config.layout.height_m - config.mount.lens_height_m;
+  std::fprintf(stderr,
+               "ceilposectl %s: warning: the markers' spacing puts the ceiling %.3f m above the "
+               "lens (median of %zu frames), the configuration says %.3f m (ceiling.height_m "
+               "%.4f - mount.lens_height_m %.4f); frames more than %.0f %% off get no pose: "
+               "check the heights (--config)\n",
+               command, scale * depth_m, depth_scales->size(), depth_m, config.layout.height_m,
+               config.mount.lens_height_m, 100.0 * limit);
+}
+
 // Localizes every frame in order, as fast as possible. Returns the exit code:
 // kExitBadInput (message printed) when a frame cannot be loaded.
 inline int run_replay(const ReplayArgs& args, const char* command, const ReplaySetup& setup,
@@ -101,6 +125,8 @@ inline int run_replay(const ReplayArgs& args, const char* command, const ReplayS
   auto result = std::make_unique<FrameResult>();
   FramePrefetcher frames(reader, args.decode_threads);
   const size_t total = reader.rows().size();
+  std::vector<double> depth_scales;
+  depth_scales.reserve(total);
   const bool tty = ::isatty(STDERR_FILENO) == 1;
   for (size_t i = 0; i < total; ++i) {
     auto loaded = frames.next();
@@ -112,6 +138,7 @@ inline int run_replay(const ReplayArgs& args, const char* command, const ReplayS
     const RecordingRow& row = reader.rows()[i];
     const int64_t start_ns = monotonic_ns();
     pipeline.process((*loaded)->view(), setup.mode, result.get());
+    if (result->estimate.depth_scale > 0.0) depth_scales.push_back(result->estimate.depth_scale);
     ReplayFrame out;
     out.estimate =
         args.filter ? filter.update(result->estimate, row.timestamp_ns) : result->estimate;
@@ -125,6 +152,7 @@ inline int run_replay(const ReplayArgs& args, const char* command, const ReplayS
       if (i + 1 == total) std::fputc('\n', stderr);
     }
   }
+  warn_if_heights_disagree(command, setup.config, &depth_scales);
   return kExitOk;
 }
 

@@ -8,7 +8,12 @@
 namespace ceilpose {
 
 // Positioning methods (issue 3): the thesis's two, and least squares over all.
-enum class PositioningMode : uint8_t { kAuto = 0, kChangeOfAxes = 1, kBarycentric = 2, kLeastSquares = 3 };
+enum class PositioningMode : uint8_t {
+  kAuto = 0,
+  kChangeOfAxes = 1,
+  kBarycentric = 2,
+  kLeastSquares = 3
+};
 
 // Names used on the command line and in JSON output: auto, axes, barycentric, lsq.
 std::string_view to_string(PositioningMode mode);
@@ -16,11 +21,16 @@ bool parse_positioning_mode(std::string_view text, PositioningMode* mode);
 
 struct PoseEstimate {
   bool valid = false;
-  Pose2D pose;                            // robot pose in `map`
-  std::array<double, 9> covariance{};     // (x_m, y_m, yaw_rad), row-major, SI units squared
+  Pose2D pose;                         // robot pose in `map`
+  std::array<double, 9> covariance{};  // (x_m, y_m, yaw_rad), row-major, SI units squared
   PositioningMode mode = PositioningMode::kAuto;  // method actually used
-  int markers = 0;                        // decoded markers used
-  double rms_residual_px = 0.0;           // reprojection residual of the solution
+  int markers = 0;                                // decoded markers used
+  double rms_residual_px = 0.0;                   // reprojection residual of the solution
+  // Camera-to-ceiling distance the markers' spacing implies, as a fraction of
+  // the configured one (median over pairs of consistent markers); 0 when
+  // fewer than two markers. Set on refused estimates too, so that callers can
+  // say why a view full of markers gives no pose.
+  double depth_scale = 0.0;
 };
 
 }  // namespace ceilpose

@@ -1,5 +1,6 @@
 #include "pipeline/positioner.h"
 
+#include <algorithm>
 #include <cmath>
 
 #include "pipeline/barycentric.h"
@@ -28,6 +29,30 @@ void Positioner::set_thesis_covariance(PoseEstimate* estimate) const {
 
 // Thesis Change of Axes uses one marker: the consistent one nearest the
 // image centre, where tilt and distortion errors are smallest.
+// For a level camera, markers d_w apart on the ceiling appear d_w / depth
+// apart in normalized image coordinates, whatever the pose; tilt and the
+// residual distortion bend that by a few percent at most, so the median over
+// all pairs measures the depth the configuration should have said.
+double Positioner::depth_scale(int fix_count) {
+  size_t pairs = 0;
+  for (int a = 0; a < fix_count; ++a) {
+    if (!inlier_[a]) continue;
+    for (int b = a + 1; b < fix_count; ++b) {
+      if (!inlier_[b]) continue;
+      const double world_m = std::hypot(fixes_[a].world_x_m - fixes_[b].world_x_m,
+                                        fixes_[a].world_y_m - fixes_[b].world_y_m);
+      const double image_n = std::hypot(fixes_[a].centre_x_n - fixes_[b].centre_x_n,
+                                        fixes_[a].centre_y_n - fixes_[b].centre_y_n);
+      if (world_m <= 0.0 || image_n <= 0.0) continue;
+      pair_scales_[pairs++] = world_m / image_n / view_.depth_m();
+    }
+  }
+  if (pairs == 0) return 0.0;
+  const auto mid = pair_scales_.begin() + static_cast<ptrdiff_t>(pairs / 2);
+  std::nth_element(pair_scales_.begin(), mid, pair_scales_.begin() + static_cast<ptrdiff_t>(pairs));
+  return *mid;
+}
+
 PoseEstimate Positioner::change_of_axes(int fix_count) const {
   PoseEstimate est;
   int best = -1;
@@ -96,7 +121,21 @@ PoseEstimate Positioner::solve(std::span<const MarkerObservation> markers, Posit
                              std::span(inlier_.data(), fix_count));
   PoseEstimate est;
   if (inliers == 0) return est;
-  // 3. The mode asked for, or in auto the best the view allows.
+  // 3. The configured heights must match what the markers' spacing says.
+  const double scale = depth_scale(fix_count);
+  est.depth_scale = scale;
+  if (scale > 0.0 && params_.max_depth_scale_error > 0.0 && !params_.lsq_estimate_height &&
+      std::fabs(scale - 1.0) > params_.max_depth_scale_error) {
+    return est;
+  }
+  // 4. The mode asked for, or in auto the best the view allows.
+  est = solve_mode(markers, fix_count, mode);
+  est.depth_scale = scale;
+  return est;
+}
+
+PoseEstimate Positioner::solve_mode(std::span<const MarkerObservation> markers, int fix_count,
+                                    PositioningMode mode) {
   switch (mode) {
     case PositioningMode::kChangeOfAxes:
       return change_of_axes(fix_count);
@@ -107,7 +146,7 @@ PoseEstimate Positioner::solve(std::span<const MarkerObservation> markers, Posit
     case PositioningMode::kAuto:
       break;
   }
-  est = least_squares(markers, fix_count);
+  PoseEstimate est = least_squares(markers, fix_count);
   if (est.valid) return est;
   est = barycentric(fix_count);
   if (est.valid) return est;

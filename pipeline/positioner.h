@@ -33,6 +33,9 @@ class Positioner {
   PoseEstimate barycentric(int fix_count) const;
   PoseEstimate least_squares(std::span<const MarkerObservation> markers, int fix_count);
   void set_thesis_covariance(PoseEstimate* estimate) const;
+  double depth_scale(int fix_count);
+  PoseEstimate solve_mode(std::span<const MarkerObservation> markers, int fix_count,
+                          PositioningMode mode);
 
   PositioningParams params_;
   ViewGeometry view_;
@@ -41,6 +44,7 @@ class Positioner {
   std::array<MarkerFix, kMaxMarkersPerFrame> fixes_{};
   std::array<bool, kMaxMarkersPerFrame> inlier_{};
   std::array<bool, kMaxMarkersPerFrame> use_{};
+  std::array<double, kMaxMarkersPerFrame*(kMaxMarkersPerFrame - 1) / 2> pair_scales_{};
 };
 
 }  // namespace ceilpose

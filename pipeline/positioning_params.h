@@ -58,6 +58,15 @@ struct PositioningParams {
   double grid_tolerance_units = 0.3;
   // ... and their headings differ by less than this, radians.
   double heading_tolerance_rad = 0.35;
+  // A pose is refused when the spacing of the markers in the image puts the
+  // ceiling farther or nearer than the configured heights by more than this
+  // fraction (median over pairs of consistent markers). With a wrong
+  // ceiling or camera height the solvers still fit, under the RMS limit, and
+  // poses came out up to 0.74 m off (ceiling 14–17 % farther than
+  // configured, docs/cross_check.md). A level camera with the right heights
+  // reads within 0.5 %; 3° of tilt moves the median by up to ~3 %. 0
+  // disables the check, as does lsq_estimate_height.
+  double max_depth_scale_error = 0.08;
 
   // --- thesis modes ---
   // Markers are considered for the Barycentric triangle only if the triangle

@@ -149,7 +149,7 @@ int run(const std::string& name, int frame_count) {
   static FrameResult result;
   Image image;
   int whole = 0, found = 0, wrong = 0, frames_with_whole = 0, valid = 0, gross = 0;
-  std::vector<double> centre_err_px, pose_err_m;
+  std::vector<double> centre_err_px, pose_err_m, depth_scale;
   const bool dump = std::getenv("DUMP") != nullptr;
   const bool slots = std::getenv("SLOTS") != nullptr;
   SlotExtremes extremes;
@@ -178,6 +178,7 @@ int run(const std::string& name, int frame_count) {
       centre_err_px.push_back(err);
     }
     found += std::min(right, in_view);
+    if (result.estimate.depth_scale > 0.0) depth_scale.push_back(result.estimate.depth_scale);
     if (result.estimate.valid) {
       ++valid;
       const double e =
@@ -197,6 +198,14 @@ int run(const std::string& name, int frame_count) {
       gross, static_cast<unsigned long>(c.cut_markers),
       static_cast<unsigned long>(c.blurred_markers), static_cast<unsigned long>(c.ambiguous_codes),
       static_cast<unsigned long>(c.inconsistent_markers));
+  if (!depth_scale.empty()) {
+    // How far the markers' spacing puts the ceiling from the configured
+    // heights (positioning refuses beyond max_depth_scale_error).
+    std::printf("depth scale over %zu frames: min %.4f p1 %.4f median %.4f p99 %.4f max %.4f\n",
+                depth_scale.size(), percentile(depth_scale, 0.0), percentile(depth_scale, 0.01),
+                percentile(depth_scale, 0.5), percentile(depth_scale, 0.99),
+                percentile(depth_scale, 1.0));
+  }
   if (slots) {
     std::printf("slot ratios: printed red dots up to %.3f, empty slots down to %.3f\n",
                 extremes.red_dot_max, extremes.empty_min);

@@ -11,6 +11,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <cstdio>
@@ -205,12 +206,20 @@ fs::path write_height_config(const XMount& mount, const fs::path& dir) {
 }
 
 // Figures of `locate` on the recording against `truth`; every line checked
-// for index order and a yaw in (-pi, pi].
-Spec6Figures score(const LocateCase& c, const std::vector<XPose>& truth, const LocateOutput& run) {
+// for index order and a yaw in (-pi, pi]. stderr must be empty, or, when
+// `allowed_warning` is given, may be the one line that starts with it.
+Spec6Figures score(const LocateCase& c, const std::vector<XPose>& truth, const LocateOutput& run,
+                   const std::string& allowed_warning = "") {
   Spec6Figures f;
   EXPECT_EQ(run.exit_code, 0) << c.name << ": " << run.stderr_text;
   // stderr is no terminal: no progress line, and nothing else (nor a sanitizer report).
-  EXPECT_EQ(run.stderr_text, "") << c.name;
+  if (allowed_warning.empty() || run.stderr_text.empty()) {
+    EXPECT_EQ(run.stderr_text, "") << c.name;
+  } else {
+    EXPECT_EQ(run.stderr_text.rfind(allowed_warning, 0), 0u) << c.name << ": " << run.stderr_text;
+    EXPECT_EQ(std::count(run.stderr_text.begin(), run.stderr_text.end(), '\n'), 1)
+        << c.name << ": " << run.stderr_text;
+  }
   EXPECT_EQ(run.lines.size(), truth.size()) << c.name << ": " << run.stderr_text;
   for (size_t k = 0; k < truth.size() && k < run.lines.size(); ++k) {
     const std::string& line = run.lines[k];
@@ -265,13 +274,17 @@ TEST_P(IndependentLocate, MeetsMeasuredAccuracy) {
     EXPECT_EQ(f.valid, f.frames) << c.name << ": a pose on every frame inside the grid";
   }
   if (!config.empty()) {
-    // Control: the same recording at SPEC's default heights must come out
-    // worse (fewer poses or a far larger error), or the heights did not
-    // reach the pipeline or did not matter.
+    // Control: the same recording at SPEC's default heights. Where markers
+    // still decode, their spacing contradicts those heights by 14-17 %, so
+    // positioning refuses the frame (max_depth_scale_error) and locate says
+    // why, instead of the confident poses up to 0.74 m off that such views
+    // used to give; further off, no marker passes the size check at all.
     const Spec6Figures at_default =
-        score(c, truth, run_locate(recording, fs::path(), scratch_.path()));
+        score(c, truth, run_locate(recording, fs::path(), scratch_.path()),
+              "ceilposectl locate: warning: the markers' spacing puts the ceiling");
     at_default.print("xlocate", c.name + "/no-config");
-    EXPECT_TRUE(at_default.valid < f.valid || at_default.max_mm() > 10.0 * f.max_mm()) << c.name;
+    EXPECT_EQ(at_default.valid, 0) << c.name;
+    EXPECT_EQ(at_default.gross, 0) << c.name;
   }
 }
 

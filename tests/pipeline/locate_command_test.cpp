@@ -64,10 +64,15 @@ class LocateCommand : public ::testing::Test {
     return s.str();
   }
 
-  // Renders the poses into a recording with ground truth.
-  fs::path record(const std::vector<Pose2D>& poses) {
+  // Renders the poses into a recording with ground truth, by default under
+  // SPEC's ceiling and camera heights.
+  fs::path record(const std::vector<Pose2D>& poses, double ceiling_height_m = 2.4384,
+                  double lens_height_m = 0.3048) {
     const fs::path rec = dir_ / "rec";
     sim::SceneOptions options;
+    options.layout.height_m = ceiling_height_m;
+    CameraMount mount;
+    mount.lens_height_m = lens_height_m;
     sim::Renderer renderer(options);
     auto writer =
         RecordingWriter::create(rec.string(), RecordingCamera{options.intrinsics, "test"});
@@ -76,7 +81,7 @@ class LocateCommand : public ::testing::Test {
     for (size_t k = 0; k < poses.size(); ++k) {
       sim::Effects effects;
       effects.read_noise_sigma = 2.0;
-      renderer.render(poses[k], CameraMount{}, effects, k + 1, &image);
+      renderer.render(poses[k], mount, effects, k + 1, &image);
       auto appended =
           writer->append(image.view(), 1'000'000'000 + 33'333'333 * int64_t(k), &poses[k]);
       EXPECT_TRUE(appended.ok()) << appended.error().message;
@@ -195,6 +200,37 @@ TEST_F(LocateCommand, ConfigFileOverridesDefaults) {
   ASSERT_EQ(out.size(), 1u);
   EXPECT_NEAR(field(out[0], "x_m"), 1.2 - 0.1 * std::cos(0.3), 0.005) << out[0];
   EXPECT_NEAR(field(out[0], "y_m"), 1.5 - 0.1 * std::sin(0.3), 0.005) << out[0];
+}
+
+TEST_F(LocateCommand, HeightsThatDisagreeWithTheMarkersGiveNoPoseAndSaySo) {
+  // Ceiling 3.0 m, lens 0.5 m: the markers are 2.5 m away, SPEC's defaults
+  // say 2.134 m. Solved with the defaults, such views gave poses up to
+  // 0.74 m off under the residual limit; they must be refused, with a word why.
+  const std::vector<Pose2D> poses{{1.2, 1.5, 0.3}, {2.0, 2.2, -2.0}, {3.0, 1.0, 1.6}};
+  const fs::path rec = record(poses, 3.0, 0.5);
+  CommandRun r = run("locate --replay " + rec.string());
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  auto out = lines(r.out);
+  ASSERT_EQ(out.size(), poses.size());
+  for (const auto& l : out) EXPECT_NE(l.find("\"valid\":false"), std::string::npos) << l;
+  for (const char* word :
+       {"warning", "2.500 m", "2.134 m", "ceiling.height_m", "mount.lens_height_m", "--config"}) {
+    EXPECT_NE(r.err.find(word), std::string::npos) << word << " in: " << r.err;
+  }
+
+  {
+    std::ofstream yaml(dir_ / "heights.yaml");
+    yaml << "ceiling:\n  height_m: 3.0\nmount:\n  lens_height_m: 0.5\n";
+  }
+  r = run("locate --config " + (dir_ / "heights.yaml").string() + " --replay " + rec.string());
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  out = lines(r.out);
+  ASSERT_EQ(out.size(), poses.size());
+  for (size_t k = 0; k < poses.size(); ++k) {
+    EXPECT_NEAR(field(out[k], "x_m"), poses[k].x_m, 0.005) << out[k];
+    EXPECT_NEAR(field(out[k], "y_m"), poses[k].y_m, 0.005) << out[k];
+  }
+  EXPECT_TRUE(r.err.empty()) << r.err;
 }
 
 TEST_F(LocateCommand, EvaluateScoresAgainstGroundTruth) {

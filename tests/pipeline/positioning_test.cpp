@@ -37,6 +37,46 @@ TEST(Positioning, AutoFallsBackToThesisModeWhenTooFewPoints) {
   EXPECT_NEAR(est.pose.y_m, robot.y_m, 1e-9);
 }
 
+TEST(Positioning, DepthScaleIsOneWhenTheHeightsAreRight) {
+  PipelineConfig config;
+  Positioner positioner(config);
+  testing::SyntheticView view;
+  view.mount.tilt_x_rad = 0.05;  // 3 degrees the configuration does not know
+  view.noise_px = 0.2;
+  for (const Pose2D robot : {Pose2D{2.0, 2.0, 1.0}, Pose2D{0.7, 3.9, -2.5}}) {
+    const PoseEstimate est =
+        positioner.solve(testing::observe(view, robot), PositioningMode::kAuto);
+    ASSERT_TRUE(est.valid);
+    EXPECT_NEAR(est.depth_scale, 1.0, 0.03);
+  }
+}
+
+TEST(Positioning, HeightsThatDisagreeWithTheMarkersSpacingAreRefused) {
+  // The camera sees a ceiling 2.5 m above the lens; the configuration says
+  // SPEC's 2.134 m.
+  testing::SyntheticView view;
+  view.layout.height_m = 3.0;
+  view.mount.lens_height_m = 0.5;
+  const Pose2D robot{2.0, 2.0, 1.0};
+  const auto markers = testing::observe(view, robot);
+  ASSERT_GE(markers.size(), 2u);
+
+  PipelineConfig config;
+  Positioner positioner(config);
+  for (const PositioningMode mode :
+       {PositioningMode::kAuto, PositioningMode::kLeastSquares, PositioningMode::kBarycentric}) {
+    const PoseEstimate est = positioner.solve(markers, mode);
+    EXPECT_FALSE(est.valid);
+    EXPECT_NEAR(est.depth_scale, 2.5 / (2.4384 - 0.3048), 0.01);
+  }
+
+  // Switched off, the same view gives a pose again (one that the wrong
+  // heights make inaccurate).
+  config.positioning.max_depth_scale_error = 0.0;
+  Positioner unchecked(config);
+  EXPECT_TRUE(unchecked.solve(markers, PositioningMode::kAuto).valid);
+}
+
 TEST(Positioning, NoMarkersGivesInvalidPose) {
   PipelineConfig config;
   Positioner positioner(config);
