@@ -112,6 +112,9 @@ const char* to_string(Problem problem) {
       return "frames without a decoded marker";
     case Problem::kInvalidPose:
       return "frames with markers but no pose";
+    case Problem::kWrongHeights:
+      return "frames refused because the markers' spacing contradicts the configured heights "
+             "(check ceiling.height_m and mount.lens_height_m)";
     case Problem::kPublishFailed:
       return "DDS writes failed";
     case Problem::kCount:

@@ -34,6 +34,7 @@ const char* journal_prefix(spdlog::level::level_enum level);
 enum class Problem : int {
   kNoMarkers,      // frame processed, no marker decoded
   kInvalidPose,    // markers seen, but no pose
+  kWrongHeights,   // no pose: the markers' spacing contradicts the configured heights
   kPublishFailed,  // DDS write failed
   kCount,
 };

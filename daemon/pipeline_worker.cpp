@@ -116,7 +116,10 @@ void PipelineWorker::process(const capture::Frame& frame) {
   if (result_.marker_count == 0) {
     problems_->count(Problem::kNoMarkers);
   } else if (!measured.valid) {
-    problems_->count(Problem::kInvalidPose);
+    problems_->count(
+        depth_scale_contradicts_heights(pipeline_.config().positioning, measured.depth_scale)
+            ? Problem::kWrongHeights
+            : Problem::kInvalidPose);
   }
 
   // 2. Filter over time (capture time, so pipeline jitter does not enter it).

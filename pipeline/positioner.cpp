@@ -124,10 +124,7 @@ PoseEstimate Positioner::solve(std::span<const MarkerObservation> markers, Posit
   // 3. The configured heights must match what the markers' spacing says.
   const double scale = depth_scale(fix_count);
   est.depth_scale = scale;
-  if (scale > 0.0 && params_.max_depth_scale_error > 0.0 && !params_.lsq_estimate_height &&
-      std::fabs(scale - 1.0) > params_.max_depth_scale_error) {
-    return est;
-  }
+  if (depth_scale_contradicts_heights(params_, scale)) return est;
   // 4. The mode asked for, or in auto the best the view allows.
   est = solve_mode(markers, fix_count, mode);
   est.depth_scale = scale;

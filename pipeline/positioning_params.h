@@ -2,6 +2,8 @@
 // Parameters of the positioning stages and the temporal filter. The defaults
 // here are the single source of truth; config/ceilpose.yaml mirrors them.
 // Every field: meaning, unit, effect, when to tune.
+#include <cmath>
+
 namespace ceilpose {
 
 struct PositioningParams {
@@ -116,5 +118,14 @@ struct FilterParams {
   double init_velocity_sigma_mps = 0.5;
   double init_yaw_rate_sigma_radps = 1.0;
 };
+
+// True when a measured depth scale (PoseEstimate::depth_scale, 0 = not
+// measured) contradicts the configured heights beyond what `params` allow:
+// positioning then refuses the frame. One rule for the positioner and for
+// the callers that explain the refusal.
+inline bool depth_scale_contradicts_heights(const PositioningParams& params, double depth_scale) {
+  return depth_scale > 0.0 && params.max_depth_scale_error > 0.0 && !params.lsq_estimate_height &&
+         std::fabs(depth_scale - 1.0) > params.max_depth_scale_error;
+}
 
 }  // namespace ceilpose

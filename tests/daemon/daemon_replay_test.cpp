@@ -6,6 +6,7 @@
 
 #include <cstdlib>
 #include <filesystem>
+#include <fstream>
 #include <sstream>
 
 #include "daemon/exit_codes.h"
@@ -18,12 +19,17 @@
 namespace ceilpose::test {
 namespace {
 
-// A 320x240 recording of the simulator's trajectory, with ground truth.
-std::string write_small_recording(int frames) {
+// A 320x240 recording of the simulator's trajectory, with ground truth, by
+// default under SPEC's ceiling and lens heights.
+std::string write_small_recording(int frames, double ceiling_height_m = 2.4384,
+                                  double lens_height_m = 0.3048) {
   const std::string dir = testing::TempDir() + "ceilposed-replay-" + std::to_string(getpid());
   std::filesystem::remove_all(dir);
   sim::SceneOptions scene;
   scene.intrinsics = sim::scaled_default_intrinsics(320);
+  scene.layout.height_m = ceiling_height_m;
+  CameraMount mount;
+  mount.lens_height_m = lens_height_m;
   RecordingCamera camera;
   camera.intrinsics = scene.intrinsics;
   camera.source = "synthetic, daemon_replay_test";
@@ -33,7 +39,7 @@ std::string write_small_recording(int frames) {
   Image frame;
   for (int i = 0; i < frames; ++i) {
     const Pose2D truth = sim::trajectory_pose(scene.layout, i / 30.0);
-    renderer.render(truth, CameraMount{}, sim::Effects{}, static_cast<uint64_t>(i), &frame);
+    renderer.render(truth, mount, sim::Effects{}, static_cast<uint64_t>(i), &frame);
     auto r = writer->append(frame.view(), 1'000'000'000 + i * 33'333'333LL, &truth);
     EXPECT_TRUE(r.ok()) << r.error().message;
   }
@@ -62,6 +68,32 @@ TEST(DaemonReplay, LocalizesWithTheRecordingsCameraNotTheConfiguredOne) {
     EXPECT_LT(std::strtod(line.c_str() + at + 5, nullptr), 10.0) << line;
   }
   EXPECT_GT(checked, 3) << r.out;
+}
+
+TEST(DaemonReplay, HeightsTheMarkersContradictGiveNoPoseAndAReasonInTheLog) {
+  // Ceiling 3.0 m and lens 0.5 m: 2.5 m to the ceiling where the default
+  // configuration says 2.134 m.
+  const std::string dir = write_small_recording(30, 3.0, 0.5);
+  const std::string shm = unique_shm_name();
+  const std::string config = dir + "-config.yaml";
+  {
+    std::ofstream yaml(config);
+    yaml << "logging:\n  problem_report_interval_ms: 300\n";
+  }
+  auto r = run_daemon({"--config", config, "--source", "replay:" + dir, "--shm", shm, "--no-dds",
+                       "--print-poses", "--duration", "2.5"});
+  (void)ShmPoseWriter::remove(shm);
+  std::filesystem::remove_all(dir);
+  std::filesystem::remove(config);
+  ASSERT_EQ(r.exit.code, daemon::kExitOk) << r.err;
+  EXPECT_NE(r.err.find("frames refused because the markers' spacing contradicts the configured "
+                       "heights (check ceiling.height_m and mount.lens_height_m)"),
+            std::string::npos)
+      << r.err;
+  // Frames were processed, and no pose was made up: --print-poses shows
+  // "no pose" lines and no position error column.
+  EXPECT_NE(r.out.find("no pose"), std::string::npos) << r.out;
+  EXPECT_EQ(r.out.find(" err "), std::string::npos) << r.out;
 }
 
 }  // namespace
