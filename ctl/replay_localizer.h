@@ -6,7 +6,6 @@
 #include <unistd.h>
 
 #include <algorithm>
-#include <cmath>
 #include <cstdio>
 #include <functional>
 #include <optional>
@@ -94,25 +93,27 @@ struct ReplayFrame {
   int64_t proc_ns = 0;
 };
 
-// After a run: when the markers' spacing says the configured heights are
-// wrong, positioning refuses those frames (max_depth_scale_error), and a
-// user would otherwise see only "valid":false; say why, once.
+// After a run: frames that positioning refused because the markers' spacing
+// contradicts the configured heights (the positioner's own rule,
+// depth_scale_contradicts_heights) would otherwise show only "valid":false;
+// say why, once, with the distance the markers imply.
 inline void warn_if_heights_disagree(const char* command, const PipelineConfig& config,
                                      std::vector<double>* depth_scales) {
-  const double limit = config.positioning.max_depth_scale_error;
-  if (depth_scales->empty() || limit <= 0.0) return;
+  const auto refused = std::count_if(depth_scales->begin(), depth_scales->end(), [&](double s) {
+    return depth_scale_contradicts_heights(config.positioning, s);
+  });
+  if (refused == 0) return;
   const auto mid = depth_scales->begin() + static_cast<ptrdiff_t>(depth_scales->size() / 2);
   std::nth_element(depth_scales->begin(), mid, depth_scales->end());
-  const double scale = *mid;
-  if (std::fabs(scale - 1.0) <= limit / 2.0) return;
   const double depth_m = config.layout.height_m - config.mount.lens_height_m;
   std::fprintf(stderr,
                "ceilposectl %s: warning: the markers' spacing puts the ceiling %.3f m above the "
                "lens (median of %zu frames), the configuration says %.3f m (ceiling.height_m "
-               "%.4f - mount.lens_height_m %.4f); frames more than %.0f %% off get no pose: "
+               "%.4f - mount.lens_height_m %.4f); %td frames more than %.0f %% off got no pose: "
                "check the heights (--config)\n",
-               command, scale * depth_m, depth_scales->size(), depth_m, config.layout.height_m,
-               config.mount.lens_height_m, 100.0 * limit);
+               command, *mid * depth_m, depth_scales->size(), depth_m, config.layout.height_m,
+               config.mount.lens_height_m, refused,
+               100.0 * config.positioning.max_depth_scale_error);
 }
 
 // Localizes every frame in order, as fast as possible. Returns the exit code:
