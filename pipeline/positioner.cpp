@@ -27,8 +27,6 @@ void Positioner::set_thesis_covariance(PoseEstimate* estimate) const {
   estimate->covariance[8] = params_.thesis_sigma_yaw_rad * params_.thesis_sigma_yaw_rad;
 }
 
-// Thesis Change of Axes uses one marker: the consistent one nearest the
-// image centre, where tilt and distortion errors are smallest.
 // For a level camera, markers d_w apart on the ceiling appear d_w / depth
 // apart in normalized image coordinates, whatever the pose; tilt and the
 // residual distortion bend that by a few percent at most, so the median over
@@ -53,6 +51,8 @@ double Positioner::depth_scale(int fix_count) {
   return *mid;
 }
 
+// Thesis Change of Axes uses one marker: the consistent one nearest the
+// image centre, where tilt and distortion errors are smallest.
 PoseEstimate Positioner::change_of_axes(int fix_count) const {
   PoseEstimate est;
   int best = -1;
