@@ -3,7 +3,7 @@
 #include <cstdio>
 
 #include "ctl/command_registry.h"
-#include "ctl/replay_localizer.h"
+#include "ctl/replay_run.h"
 #include "pipeline/accuracy_metrics.h"
 #include "sim/visibility.h"
 
@@ -60,17 +60,15 @@ void add_evaluate_command(CLI::App& app) {
                    args->dir.c_str());
       rc = kExitBadInput;
     }
-    AccuracyAccumulator acc(setup.config.layout.grid_m);
     const sim::SceneOptions scene{setup.config.layout, setup.config.intrinsics};
+    AccuracySink accuracy(setup.config.layout.grid_m, [&](const Pose2D& truth) {
+      return sim::count_whole_markers(scene, truth, setup.config.mount) > 0;
+    });
     if (rc == kExitOk) {
-      rc = run_replay(*args, "evaluate", setup, [&](const ReplayFrame& f) {
-        if (!f.row->has_ground_truth) return;
-        const bool whole =
-            sim::count_whole_markers(scene, f.row->ground_truth, setup.config.mount) > 0;
-        acc.add(f.row->ground_truth, whole, f.estimate);
-      });
+      PoseSink* sinks[] = {&accuracy};
+      rc = run_replay(*args, "evaluate", setup, sinks);
     }
-    if (rc == kExitOk) print_report(acc.report(), *json);
+    if (rc == kExitOk) print_report(accuracy.report(), *json);
     std::fflush(stdout);
     set_exit_code(rc);
   });

@@ -5,35 +5,46 @@
 
 #include "core/json_text.h"
 #include "ctl/command_registry.h"
-#include "ctl/replay_localizer.h"
+#include "ctl/replay_run.h"
 
 namespace ceilpose::ctl {
 namespace {
 
-// Metres and radians to 0.1 µm / 0.1 µrad: far below the accuracy, so the
-// output never hides a difference the estimate makes.
-void print_frame(const ReplayFrame& f, PositioningMode requested) {
-  const PoseEstimate& e = f.estimate;
-  // An invalid frame names the mode that was asked for: none was used.
-  const std::string_view mode = to_string(e.valid ? e.mode : requested);
-  if (e.valid) {
-    std::printf("{\"index\":%" PRId64 ",\"timestamp_ns\":%" PRId64
-                ",\"valid\":true,\"x_m\":%.7f,\"y_m\":%.7f,\"yaw_rad\":%.7f,\"mode\":\"%.*s\","
-                "\"markers\":%d,\"proc_us\":%" PRId64
-                ",\"rms_px\":%.3f,\"cov\":[%.3e,%.3e,%.3e,%.3e,%.3e,%.3e]}\n",
-                f.row->index, f.row->timestamp_ns, e.pose.x_m, e.pose.y_m,
-                printable_yaw_rad(e.pose.yaw_rad, 7), static_cast<int>(mode.size()), mode.data(),
-                e.markers, (f.proc_ns + 500) / 1000, e.rms_residual_px, e.covariance[0],
-                e.covariance[1], e.covariance[2], e.covariance[4], e.covariance[5],
-                e.covariance[8]);
-  } else {
-    std::printf("{\"index\":%" PRId64 ",\"timestamp_ns\":%" PRId64
-                ",\"valid\":false,\"x_m\":null,\"y_m\":null,\"yaw_rad\":null,\"mode\":\"%.*s\","
-                "\"markers\":%d,\"proc_us\":%" PRId64 "}\n",
-                f.row->index, f.row->timestamp_ns, static_cast<int>(mode.size()), mode.data(),
-                e.markers, (f.proc_ns + 500) / 1000);
+// One JSON object per frame (SPEC §5). Metres and radians to 0.1 µm /
+// 0.1 µrad: far below the accuracy, so the output never hides a difference
+// the estimate makes.
+class JsonLinesSink final : public PoseSink {
+ public:
+  explicit JsonLinesSink(PositioningMode requested) : requested_(requested) {}
+
+  void consume(const Localization& loc) override {
+    const PoseEstimate& e = loc.published;
+    const int64_t proc_us = (loc.localize_ns + 500) / 1000;
+    // An invalid frame names the mode that was asked for: none was used.
+    const std::string_view mode = to_string(e.valid ? e.mode : requested_);
+    if (e.valid) {
+      std::printf("{\"index\":%" PRId64 ",\"timestamp_ns\":%" PRId64
+                  ",\"valid\":true,\"x_m\":%.7f,\"y_m\":%.7f,\"yaw_rad\":%.7f,\"mode\":\"%.*s\","
+                  "\"markers\":%d,\"proc_us\":%" PRId64
+                  ",\"refusal\":null,\"rms_px\":%.3f,\"cov\":[%.3e,%.3e,%.3e,%.3e,%.3e,%.3e]}\n",
+                  loc.frame.index, loc.frame.timestamp_ns, e.pose.x_m, e.pose.y_m,
+                  printable_yaw_rad(e.pose.yaw_rad, 7), static_cast<int>(mode.size()), mode.data(),
+                  e.markers, proc_us, e.rms_residual_px, e.covariance[0], e.covariance[1],
+                  e.covariance[2], e.covariance[4], e.covariance[5], e.covariance[8]);
+    } else {
+      const std::string_view refusal = to_string(e.refusal);
+      std::printf("{\"index\":%" PRId64 ",\"timestamp_ns\":%" PRId64
+                  ",\"valid\":false,\"x_m\":null,\"y_m\":null,\"yaw_rad\":null,\"mode\":\"%.*s\","
+                  "\"markers\":%d,\"proc_us\":%" PRId64 ",\"refusal\":\"%.*s\"}\n",
+                  loc.frame.index, loc.frame.timestamp_ns, static_cast<int>(mode.size()),
+                  mode.data(), e.markers, proc_us, static_cast<int>(refusal.size()),
+                  refusal.data());
+    }
   }
-}
+
+ private:
+  PositioningMode requested_;
+};
 
 void add_locate_command(CLI::App& app) {
   auto args = std::make_shared<ReplayArgs>();
@@ -41,16 +52,18 @@ void add_locate_command(CLI::App& app) {
       "locate",
       "Localize every frame of a recording in order, as fast as possible; one JSON object per "
       "frame on stdout (SPEC §5): index, timestamp_ns, valid, x_m, y_m, yaw_rad (null when "
-      "invalid), mode, markers, proc_us, and for valid frames rms_px and cov (the upper "
-      "triangle of the (x, y, yaw) covariance: xx, xy, xyaw, yy, yyaw, yawyaw). Errors on "
-      "stderr; exit 4 for a malformed recording or configuration, 2 for usage.");
+      "invalid), mode, markers, proc_us, refusal (why an invalid frame has no pose, e.g. "
+      "no_markers, wrong_heights; null when valid), and for valid frames rms_px and cov (the "
+      "upper triangle of the (x, y, yaw) covariance: xx, xy, xyaw, yy, yyaw, yawyaw). Errors "
+      "on stderr; exit 4 for a malformed recording or configuration, 2 for usage.");
   add_replay_options(cmd, args.get());
   cmd->callback([args] {
     ReplaySetup setup;
     int rc = prepare_replay(*args, "locate", &setup);
     if (rc == kExitOk) {
-      rc = run_replay(*args, "locate", setup,
-                      [&](const ReplayFrame& f) { print_frame(f, setup.mode); });
+      JsonLinesSink out(setup.localizer.mode);
+      PoseSink* sinks[] = {&out};
+      rc = run_replay(*args, "locate", setup, sinks);
     }
     std::fflush(stdout);
     set_exit_code(rc);

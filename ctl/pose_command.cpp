@@ -16,7 +16,7 @@ namespace {
 struct PoseArgs {
   std::string shm = CEILPOSE_DEFAULT_SHM_NAME;
   bool json = false;
-  int64_t stale_ms = kDefaultStaleAfterMs;
+  int64_t stale_ms = 0;  // 0: the daemon's ipc.stale_after_ms, from the segment
 };
 
 int report_no_pose(const PoseArgs& args, const std::string& daemon, const std::string& why) {
@@ -56,9 +56,10 @@ int run_pose(const PoseArgs& args) {
   if (liveness != Liveness::kLive) {
     problem = "daemon (pid " + std::to_string(info.pid) + ") on " + args.shm + " is " +
               to_string(liveness) + "; last pose is " + fixed_text(age_ms, 1) + " ms old";
-  } else if (age_ms > static_cast<double>(args.stale_ms)) {
+  } else if (const int64_t limit_ms = reader->stale_after_ms(args.stale_ms);
+             age_ms > static_cast<double>(limit_ms)) {
     problem = "pose is stale: " + fixed_text(age_ms, 1) + " ms old (limit " +
-              std::to_string(args.stale_ms) + " ms), daemon pid " + std::to_string(info.pid) +
+              std::to_string(limit_ms) + " ms), daemon pid " + std::to_string(info.pid) +
               " is alive but not publishing";
   }
   const std::string daemon = problem.empty() || liveness != Liveness::kLive
@@ -89,9 +90,10 @@ void add_pose_command(CLI::App& app) {
       "timestamp_ns (capture, CLOCK_MONOTONIC) and more, plus daemon and live.");
   cmd->add_option("--shm", args->shm, "shared-memory segment name")->capture_default_str();
   cmd->add_flag("--json", args->json, "one JSON object for scripts");
-  cmd->add_option("--stale-ms", args->stale_ms, "a pose or heartbeat older than this is stale")
-      ->capture_default_str()
-      ->check(CLI::PositiveNumber);
+  cmd->add_option("--stale-ms", args->stale_ms,
+                  "a pose or heartbeat older than this is stale"
+                  " (default: the daemon's ipc.stale_after_ms, published in the segment)")
+      ->check(CLI::NonNegativeNumber);
   cmd->callback([args] {
     const int rc = run_pose(*args);
     std::fflush(stdout);

@@ -1,12 +1,14 @@
 // ceilposectl status: the daemon's health from its shared-memory segment —
 // state, pid, uptime, frame rate, frames, drops, outages, latency percentiles,
-// fix state and source. Exit 0 when the daemon is live, 3 otherwise.
+// fix state, source and frames per refusal reason. Exit 0 when the daemon is live, 3 otherwise.
+#include <algorithm>
 #include <cinttypes>
 #include <cstdio>
 #include <memory>
 #include <string>
 
 #include "core/clock.h"
+#include "core/refusal.h"
 #include "ctl/command_registry.h"
 #include "ipc/shm/pose_text.h"
 #include "ipc/shm/shm_pose_reader.h"
@@ -17,7 +19,7 @@ namespace {
 struct StatusArgs {
   std::string shm = CEILPOSE_DEFAULT_SHM_NAME;
   bool json = false;
-  int64_t stale_ms = kDefaultStaleAfterMs;
+  int64_t stale_ms = 0;  // 0: the daemon's ipc.stale_after_ms, from the segment
 };
 
 struct Snapshot {
@@ -36,6 +38,17 @@ int64_t run_ns(const Snapshot& s) {
   const int64_t end_ns =
       s.info.state == WriterState::kStopped ? s.info.heartbeat_mono_ns : s.now_ns;
   return end_ns - s.info.start_mono_ns;
+}
+
+// Frames per refusal reason (kNone: frames with a pose), as the daemon counted
+// them; a reason newer than this ceilposectl is named by its index.
+template <typename Fn>
+void for_each_refusal(const StatusRecord& st, Fn&& fn) {
+  const uint32_t n = std::min<uint32_t>(st.refusal_count, CEILPOSE_REFUSAL_SLOTS);
+  for (uint32_t i = 0; i < n; ++i) {
+    const std::string_view name = refusal_name(static_cast<int>(i));
+    fn(name == "unknown" ? "reason_" + std::to_string(i) : std::string(name), st.refusals[i]);
+  }
 }
 
 std::string age_ms_json(bool known, int64_t now_ns, int64_t then_ns) {
@@ -62,12 +75,21 @@ void print_json(const StatusArgs& args, const Snapshot& s) {
            ",\"p99\":" + std::to_string(st.latency_p99_us) +
            ",\"max\":" + std::to_string(st.latency_max_us) + "}" +
            ",\"fix\":" + json_quote(to_string(static_cast<FixState>(st.fix_state))) +
-           ",\"source\":" + json_quote(st.source) +
+           ",\"source\":" + json_quote(st.source) + ",\"refusals\":{";
+    bool first = true;
+    for_each_refusal(st, [&](const std::string& name, uint64_t count) {
+      if (name == to_string(Refusal::kNone)) return;
+      out += (first ? "" : ",") + json_quote(name) + ":" + std::to_string(count);
+      first = false;
+    });
+    out += "}" + std::string(",\"localized\":") +
+           std::to_string(st.refusal_count > 0 ? st.refusals[0] : 0) +
            ",\"status_age_ms\":" + age_ms_json(true, s.now_ns, st.updated_mono_ns);
   } else {
     out +=
         ",\"fps\":null,\"frames\":null,\"drops\":null,\"skipped\":null,\"outages\":null,"
-        "\"latency_us\":null,\"fix\":null,\"source\":null,\"status_age_ms\":null";
+        "\"latency_us\":null,\"fix\":null,\"source\":null,\"refusals\":null,"
+        "\"localized\":null,\"status_age_ms\":null";
   }
   out += ",\"last_seq\":" + (s.has_pose ? std::to_string(s.pose.seq) : std::string("null")) +
          ",\"last_pose_age_ms\":" + age_ms_json(s.has_pose, s.now_ns, s.pose.publish_mono_ns) + "}";
@@ -97,6 +119,13 @@ void print_human(const StatusArgs& args, const Snapshot& s) {
         "  (capture -> pose published)\n",
         st.latency_p50_us / 1e3, st.latency_p90_us / 1e3, st.latency_p99_us / 1e3,
         st.latency_max_us / 1e3);
+    std::string refused;
+    for_each_refusal(st, [&](const std::string& name, uint64_t count) {
+      if (count == 0 || name == to_string(Refusal::kNone)) return;
+      refused += (refused.empty() ? "" : ", ") + name + " " + std::to_string(count);
+    });
+    std::printf("  no pose    %s  (frames per refusal since start)\n",
+                refused.empty() ? "none refused" : refused.c_str());
   } else {
     std::printf("  (the daemon has not reported its status yet)\n");
   }
@@ -144,13 +173,16 @@ void add_status_command(CLI::App& app) {
   CLI::App* cmd = app.add_subcommand(
       "status",
       "Show the daemon's health from its shared memory: state, pid, uptime, fps, frames, drops, "
-      "skipped, outages, latency percentiles, fix state, source. Exit 0 when the daemon is live "
+      "skipped, outages, latency percentiles, fix state, source, and frames per refusal reason "
+      "(--json: an object \"refusals\" of reason -> count, \"localized\" the frames with a pose). "
+      "Exit 0 when the daemon is live "
       "(or starting), 3 when none is publishing or it stopped, died or is stale.");
   cmd->add_option("--shm", args->shm, "shared-memory segment name")->capture_default_str();
   cmd->add_flag("--json", args->json, "one JSON object for scripts");
-  cmd->add_option("--stale-ms", args->stale_ms, "a heartbeat older than this is stale")
-      ->capture_default_str()
-      ->check(CLI::PositiveNumber);
+  cmd->add_option("--stale-ms", args->stale_ms,
+                  "a heartbeat older than this is stale"
+                  " (default: the daemon's ipc.stale_after_ms, published in the segment)")
+      ->check(CLI::NonNegativeNumber);
   cmd->callback([args] {
     const int rc = run_status(*args);
     std::fflush(stdout);

@@ -21,8 +21,8 @@ namespace {
 struct WatchArgs {
   std::string shm = CEILPOSE_DEFAULT_SHM_NAME;
   bool json = false;
-  uint64_t count = 0;  // 0: until interrupted
-  int64_t stale_ms = kDefaultStaleAfterMs;
+  uint64_t count = 0;    // 0: until interrupted
+  int64_t stale_ms = 0;  // 0: the daemon's ipc.stale_after_ms, from the segment
 };
 
 // How long one wait lasts before the reader re-checks for a restart.
@@ -113,9 +113,10 @@ void add_watch_command(CLI::App& app) {
   cmd->add_flag("--json", args->json, "JSON lines for machines");
   cmd->add_option("--count", args->count, "stop after N poses (0: until interrupted)")
       ->capture_default_str();
-  cmd->add_option("--stale-ms", args->stale_ms, "a heartbeat older than this is stale")
-      ->capture_default_str()
-      ->check(CLI::PositiveNumber);
+  cmd->add_option("--stale-ms", args->stale_ms,
+                  "a heartbeat older than this is stale"
+                  " (default: the daemon's ipc.stale_after_ms, published in the segment)")
+      ->check(CLI::NonNegativeNumber);
   cmd->callback([args] {
     const int rc = run_watch(*args);
     std::fflush(stdout);

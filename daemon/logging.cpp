@@ -106,34 +106,4 @@ void setup_logging(LogTarget target, LogLevel level) {
 
 void set_log_level(LogLevel level) { spdlog::default_logger()->set_level(to_spdlog(level)); }
 
-const char* to_string(Problem problem) {
-  switch (problem) {
-    case Problem::kNoMarkers:
-      return "frames without a decoded marker";
-    case Problem::kInvalidPose:
-      return "frames with markers but no pose";
-    case Problem::kWrongHeights:
-      return "frames refused because the markers' spacing contradicts the configured heights "
-             "(check ceiling.height_m and mount.lens_height_m)";
-    case Problem::kPublishFailed:
-      return "DDS writes failed";
-    case Problem::kCount:
-      break;
-  }
-  return "unknown problem";
-}
-
-void ProblemCounters::report(double interval_s) {
-  std::string line;
-  for (int i = 0; i < static_cast<int>(Problem::kCount); ++i) {
-    const uint64_t now = counts_[i].load(std::memory_order_relaxed);
-    const uint64_t delta = now - reported_[i];
-    reported_[i] = now;
-    if (delta == 0) continue;
-    if (!line.empty()) line += ", ";
-    line += std::to_string(delta) + " " + to_string(static_cast<Problem>(i));
-  }
-  if (!line.empty()) spdlog::warn("last {:.1f} s: {}", interval_s, line);
-}
-
 }  // namespace ceilpose::daemon

@@ -4,14 +4,10 @@
 // sd-daemon priority prefix and adds its own timestamp, so none is printed.
 // At a terminal: local time, colour by level.
 //
-// Per-frame code never logs: it counts (ProblemCounters) and the control
-// thread reports the counts at most once per interval.
+// Per-frame code never logs: it counts (the localizer's refusal histogram)
+// and the control thread reports the counts at most once per interval
+// (daemon/problem_report.h).
 #include <spdlog/spdlog.h>
-
-#include <array>
-#include <atomic>
-#include <cstdint>
-#include <string>
 
 #include "config/service_config.h"
 
@@ -29,34 +25,5 @@ spdlog::level::level_enum to_spdlog(LogLevel level);
 
 // "<3>" for spdlog's err, etc. (sd-daemon.h SD_ERR ...).
 const char* journal_prefix(spdlog::level::level_enum level);
-
-// Kinds of per-frame trouble, counted by the pipeline thread.
-enum class Problem : int {
-  kNoMarkers,      // frame processed, no marker decoded
-  kInvalidPose,    // markers seen, but no pose
-  kWrongHeights,   // no pose: the markers' spacing contradicts the configured heights
-  kPublishFailed,  // DDS write failed
-  kCount,
-};
-const char* to_string(Problem problem);
-
-// Single writer (pipeline thread) increments; the control thread reports
-// what accumulated since its last report. Lock-free, allocation-free.
-class ProblemCounters {
- public:
-  void count(Problem p) noexcept {
-    counts_[static_cast<int>(p)].fetch_add(1, std::memory_order_relaxed);
-  }
-  uint64_t total(Problem p) const noexcept {
-    return counts_[static_cast<int>(p)].load(std::memory_order_relaxed);
-  }
-  // Logs one warning line listing each problem that grew since the last call
-  // (e.g. "last 10.0 s: 37 frames without markers, 2 DDS writes failed").
-  void report(double interval_s);
-
- private:
-  std::array<std::atomic<uint64_t>, static_cast<int>(Problem::kCount)> counts_{};
-  std::array<uint64_t, static_cast<int>(Problem::kCount)> reported_{};
-};
 
 }  // namespace ceilpose::daemon

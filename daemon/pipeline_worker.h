@@ -1,12 +1,13 @@
 #pragma once
-// The pipeline thread of ceilposed: takes the newest frame from the capture
-// thread, localizes it, filters the pose, publishes it on shared memory and
-// DDS, and stamps the frame's latency. It is also the single writer of the
-// shared-memory segment and the DDS writers while it runs (both require one
-// thread), so it refreshes their status records too.
+// The pipeline thread of ceilposed: CaptureThread -> Localizer -> sinks
+// (shared memory, DDS). Takes the newest frame, localizes it, hands the
+// Localization to every sink and stamps the frame's latency. It is also the
+// single writer of the sinks while it runs (shared memory and DDS writers
+// require one thread), so it publishes their status records too, each at the
+// sink's own period.
 //
-// Per frame: no allocation, no exception, no logging; problems are counted in
-// ProblemCounters and progress in ProgressCounter (the watchdog's evidence).
+// Per frame: no allocation, no exception, no logging; refusals are counted by
+// the Localizer and progress in ProgressCounter (the watchdog's evidence).
 //
 // Threads: constructor, start(), stop(), reload() and the accessors from the
 // control thread; everything else runs on the worker's own thread.
@@ -15,32 +16,30 @@
 #include <memory>
 #include <mutex>
 #include <optional>
+#include <span>
 #include <thread>
+#include <vector>
 
 #include "capture/capture_thread.h"
 #include "capture/latency_histogram.h"
 #include "config/service_config.h"
-#include "daemon/logging.h"
+#include "core/fix_state.h"
+#include "daemon/publishing_sink.h"
 #include "daemon/watchdog_gate.h"
-#include "ipc/shm/shm_pose_writer.h"
-#include "pipeline/pipeline.h"
-#include "pipeline/temporal_filter.h"
-
-namespace ceilpose {
-class DdsPosePublisher;
-}
+#include "pipeline/localizer.h"
 
 namespace ceilpose::daemon {
 
 // The latest published pose as the control thread sees it (--print-poses,
 // STATUS=). Trivially copyable.
 struct PoseSnapshot {
-  uint64_t seq = 0;  // shared-memory sequence number; 0 = none yet
+  uint64_t frame = 0;  // frames localized so far; 0 = none yet
   int64_t capture_ns = 0;
   bool valid = false;
   Pose2D pose;
   PositioningMode mode = PositioningMode::kAuto;
   int markers = 0;
+  Refusal refusal = Refusal::kNone;  // why the frame gave no measurement
   bool has_ground_truth = false;
   Pose2D ground_truth;
   int64_t latency_ns = 0;  // frame dequeued -> pose published
@@ -49,7 +48,6 @@ struct PoseSnapshot {
 };
 
 struct WorkerOptions {
-  int status_interval_ms = 1000;
   int rt_priority = 0;  // SCHED_FIFO priority of the thread; 0 = normal scheduling
   // Test hook (CEILPOSE_TEST_STALL_AFTER_FRAMES, docs/service.md): after this
   // many frames the thread stops making progress until stop(), as a hung
@@ -62,9 +60,10 @@ struct WorkerOptions {
 
 class PipelineWorker {
  public:
+  // `sinks` are used from the worker's thread only while it runs.
   PipelineWorker(const ServiceConfig& config, WorkerOptions options,
-                 capture::CaptureThread* capture, ShmPoseWriter* shm, DdsPosePublisher* dds,
-                 ProblemCounters* problems, ProgressCounter* progress);
+                 capture::CaptureThread* capture, std::span<PublishingSink* const> sinks,
+                 ProgressCounter* progress);
   ~PipelineWorker();
   PipelineWorker(const PipelineWorker&) = delete;
   PipelineWorker& operator=(const PipelineWorker&) = delete;
@@ -84,38 +83,33 @@ class PipelineWorker {
   uint64_t frames() const { return frames_.load(std::memory_order_relaxed); }
   // Whether the thread got SCHED_FIFO (valid after start()).
   bool realtime() const { return realtime_.load(std::memory_order_acquire); }
+  // Frames per refusal since start (any thread).
+  const RefusalHistogram& refusals() const { return localizer_.refusals(); }
 
  private:
   struct Pending {
     PipelineConfig pipeline;
-    PositioningMode mode;
+    LocalizerOptions localizer;
     bool reset_filter;
   };
 
   void run();
   void apply_pending();
   void process(const capture::Frame& frame);
-  void publish_status(int64_t now_ns);
+  void publish_status(int64_t now_ns, bool all);
+  void update_fps(int64_t now_ns);
   void stall_until_stopped();
 
   const WorkerOptions options_;
   capture::CaptureThread* capture_;
-  ShmPoseWriter* shm_;
-  DdsPosePublisher* dds_;
-  ProblemCounters* problems_;
+  const std::vector<PublishingSink*> sinks_;
   ProgressCounter* progress_;
 
   // Pipeline-thread state.
-  Pipeline pipeline_;
-  PositioningMode mode_;
-  bool filter_enabled_;
-  TemporalFilter filter_;
-  FrameResult result_;
-  bool had_fix_ = false;
-  FixState fix_ = FixState::kNone;
-  int64_t next_status_ns_ = 0;
-  uint64_t frames_at_status_ = 0;
-  int64_t status_ns_ = 0;
+  Localizer localizer_;
+  std::vector<int64_t> next_status_ns_;  // per sink
+  uint64_t frames_at_fps_ = 0;
+  int64_t fps_ns_ = 0;
   double fps_ = 0.0;
   PoseSnapshot last_;
 

@@ -18,11 +18,14 @@
 #include "daemon/exit_codes.h"
 #include "daemon/logging.h"
 #include "daemon/pipeline_worker.h"
+#include "daemon/problem_report.h"
+#include "daemon/shm_pose_sink.h"
 #include "daemon/signal_channel.h"
 #include "daemon/systemd_notifier.h"
 #include "daemon/watchdog_gate.h"
 #include "ipc/shm/shm_pose_writer.h"
 #ifdef CEILPOSE_DAEMON_HAVE_DDS
+#include "daemon/dds_pose_sink.h"
 #include "ipc/dds/dds_options.h"
 #include "ipc/dds/dds_pose_publisher.h"
 #endif
@@ -113,8 +116,9 @@ void print_pose(const PoseSnapshot& s, int64_t start_ns) {
         s.fix == FixState::kCoasting ? "coasting" : std::string(to_string(s.mode)).c_str(),
         s.markers);
   } else {
-    n = std::snprintf(line, sizeof(line), "t=%8.3f s  no pose (%s)%*s %2d markers", t_s,
-                      fix_name(s.fix), 36, "", s.markers);
+    const std::string_view why = to_string(s.refusal);
+    n = std::snprintf(line, sizeof(line), "t=%8.3f s  no pose (%s: %.*s)%*s %2d markers", t_s,
+                      fix_name(s.fix), static_cast<int>(why.size()), why.data(), 16, "", s.markers);
   }
   if (s.has_ground_truth && n > 0 && n < static_cast<int>(sizeof(line))) {
     const Pose2D& g = s.ground_truth;
@@ -157,13 +161,16 @@ class Service {
   const DaemonOptions& options_;
   SignalChannel signals_;  // first: blocks the signals before any thread exists
   SystemdNotifier notifier_;
-  ProblemCounters problems_;
+  ProblemReport problems_;
   ProgressCounter progress_;
   std::unique_ptr<capture::CaptureThread> capture_;
   std::optional<ShmPoseWriter> shm_;
+  std::optional<ShmPoseSink> shm_sink_;
 #ifdef CEILPOSE_DAEMON_HAVE_DDS
   std::optional<DdsPosePublisher> dds_;
+  std::optional<DdsPoseSink> dds_sink_;
 #endif
+  std::vector<PublishingSink*> sinks_;
   std::unique_ptr<PipelineWorker> worker_;
   int exit_code_ = kExitOk;
   int64_t start_ns_ = 0;
@@ -205,15 +212,17 @@ int Service::start() {
   ShmOptions sopts;
   sopts.name = config_.ipc.shm_name;
   sopts.group = config_.ipc.group;
+  sopts.stale_after_ms = config_.ipc.stale_after_ms;
   auto shm = ShmPoseWriter::create(sopts);
   if (!shm) {
     spdlog::error("shared memory: {}", shm.error().message);
     return kExitRuntime;
   }
   shm_.emplace(std::move(shm).value());
+  shm_sink_.emplace(&*shm_, config_.watchdog.status_interval_ms);
+  sinks_.push_back(&*shm_sink_);
 
   // 3. DDS.
-  DdsPosePublisher* dds = nullptr;
 #ifdef CEILPOSE_DAEMON_HAVE_DDS
   if (config_.dds.enabled) {
     DdsOptions dopts;
@@ -235,8 +244,10 @@ int Service::start() {
       return kExitRuntime;
     }
     dds_.emplace(std::move(pub).value());
-    dds = &*dds_;
-    spdlog::info("DDS: domain {} topic {}", dds->domain_id(), dds->pose_topic());
+    dds_sink_.emplace(&*dds_, config_.dds.status_period_ms);
+    sinks_.push_back(&*dds_sink_);
+    spdlog::info("DDS: domain {} topic {}, status every {} ms", dds_->domain_id(),
+                 dds_->pose_topic(), config_.dds.status_period_ms);
   }
 #else
   if (config_.dds.enabled) spdlog::warn("DDS: not built into this ceilposed; shared memory only");
@@ -244,11 +255,10 @@ int Service::start() {
 
   // 4. Pipeline thread.
   WorkerOptions wopts;
-  wopts.status_interval_ms = config_.watchdog.status_interval_ms;
   wopts.stall_after_frames = stall_after_frames_from_env();
   wopts.rt_priority = config_.capture.pipeline_rt_priority;
-  worker_ = std::make_unique<PipelineWorker>(running_config(config_), wopts, capture_.get(), &*shm_,
-                                             dds, &problems_, &progress_);
+  worker_ = std::make_unique<PipelineWorker>(running_config(config_), wopts, capture_.get(), sinks_,
+                                             &progress_);
   worker_->start();
   if (wopts.rt_priority > 0 && !worker_->realtime())
     spdlog::warn(
@@ -281,7 +291,7 @@ void Service::loop() {
   int64_t next_status = now + status_period_ns;
   int64_t next_problems = now + problem_period_ns;
   int64_t next_print = now;
-  uint64_t printed_seq = 0;
+  uint64_t printed_frame = 0;
   bool stalled_reported = false;
 
   for (;;) {
@@ -330,13 +340,16 @@ void Service::loop() {
     }
     if (now >= next_problems) {
       next_problems = now + problem_period_ns;
-      problems_.report(static_cast<double>(problem_period_ns) * 1e-9);
+      uint64_t failures = 0;
+      for (const PublishingSink* sink : sinks_) failures += sink->failures();
+      problems_.report(worker_->refusals().snapshot(), failures,
+                       static_cast<double>(problem_period_ns) * 1e-9);
     }
     if (options_.print_poses && now >= next_print) {
       next_print = now + kPrintPeriodNs;
       const PoseSnapshot s = worker_->latest();
-      if (s.seq != printed_seq && s.seq != 0) {
-        printed_seq = s.seq;
+      if (s.frame != printed_frame && s.frame != 0) {
+        printed_frame = s.frame;
         print_pose(s, start_ns_);
       }
     }

@@ -4,11 +4,14 @@
 // keeps every error to take percentiles).
 #include <array>
 #include <cstdint>
+#include <functional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "core/pose.h"
 #include "pipeline/pose_estimate.h"
+#include "pipeline/pose_sink.h"
 
 namespace ceilpose {
 
@@ -46,6 +49,26 @@ class AccuracyAccumulator {
   int within_both_ = 0, within_x_ = 0, within_y_ = 0;
   std::vector<double> error_m_;
   std::vector<double> yaw_error_rad_;
+};
+
+// The accuracy scoring of a replay or a simulated run as a PoseSink: frames
+// with ground truth are scored on their published pose. `whole_in_view`
+// tells whether a whole marker was in view at a true pose (the availability
+// denominator; the caller knows the camera and ceiling, e.g. the simulator's
+// visibility).
+class AccuracySink final : public PoseSink {
+ public:
+  AccuracySink(double grid_m, std::function<bool(const Pose2D&)> whole_in_view)
+      : acc_(grid_m), whole_in_view_(std::move(whole_in_view)) {}
+  void consume(const Localization& loc) override {
+    if (loc.frame.has_ground_truth)
+      acc_.add(loc.frame.ground_truth, whole_in_view_(loc.frame.ground_truth), loc.published);
+  }
+  AccuracyReport report() const { return acc_.report(); }
+
+ private:
+  AccuracyAccumulator acc_;
+  std::function<bool(const Pose2D&)> whole_in_view_;
 };
 
 // One Markdown table row: set | availability | both axes | median / p99 |

@@ -72,13 +72,14 @@ bool Pipeline::usable(const ImageView& frame) const {
   return frame.size_bytes == 0 || frame.size_bytes >= needed;
 }
 
-bool Pipeline::decode(const ImageView& frame, const MarkerPair& pair, MarkerObservation* out) {
+bool Pipeline::decode(const ImageView& frame, const MarkerPair& pair, MarkerRejects* rejects,
+                      MarkerObservation* out) {
   const RectangleCandidate& red = rects_[pair.red];
   const RectangleCandidate& green = rects_[pair.green];
   // A rectangle cut by the frame border has a shifted centroid, which puts
   // the slots off the dots: such a marker could only be misread.
   if (red.touches_border || green.touches_border) {
-    ++counters_.cut_markers;
+    ++rejects->cut;
     return false;
   }
   const CeilingLayout& layout = config_.layout;
@@ -89,24 +90,24 @@ bool Pipeline::decode(const ImageView& frame, const MarkerPair& pair, MarkerObse
   const double red_dot_px = layout.red_dot_n_m * px_per_m;
   const double blur_px = edge_spread_px(frame, m, true, layout);
   if (blur_px > config_.detector.max_blur_to_dot * red_dot_px) {
-    ++counters_.blurred_markers;
+    ++rejects->blurred;
     return false;
   }
   const float threshold = dot_threshold_ratio(config_.detector, blur_px, red_dot_px);
   const CodeReading code_i = read_code(frame, m, true, layout, config_.detector, threshold);
   const CodeReading code_j = read_code(frame, m, false, layout, config_.detector, threshold);
   if (!code_i.ok || !code_j.ok) {
-    ++counters_.unreadable_codes;
+    ++rejects->unreadable;
     return false;
   }
   if (std::min(code_i.margin, code_j.margin) < config_.detector.dot_min_margin) {
-    ++counters_.ambiguous_codes;
+    ++rejects->ambiguous;
     return false;
   }
   if (code_i.code >= layout.codes() || code_j.code >= layout.codes() ||
       !dark_area_consistent(red, code_i.code, true, layout, px_per_m) ||
       !dark_area_consistent(green, code_j.code, false, layout, px_per_m)) {
-    ++counters_.inconsistent_markers;
+    ++rejects->inconsistent;
     return false;
   }
   MarkerObservation& o = *out;
@@ -144,6 +145,15 @@ bool Pipeline::decode(const ImageView& frame, const MarkerPair& pair, MarkerObse
   return true;
 }
 
+// With no marker decoded, the frame is refused for what stopped the pairs it
+// had: none at all, only codes contradicting the dark area, or unreadable.
+Refusal Pipeline::refusal_without_markers(const FrameResult& result, size_t pair_count) {
+  if (pair_count == 0) return result.noisy ? Refusal::kNoisyFrame : Refusal::kNoMarkers;
+  const MarkerRejects& r = result.rejects;
+  if (r.inconsistent > 0 && r.inconsistent == r.total()) return Refusal::kInconsistentMarkers;
+  return Refusal::kUnreadableMarkers;
+}
+
 void Pipeline::process(const ImageView& frame, PositioningMode mode, FrameResult* out) {
   const int64_t start_ns = monotonic_ns();
   int64_t stamp_ns = start_ns;
@@ -152,23 +162,23 @@ void Pipeline::process(const ImageView& frame, PositioningMode mode, FrameResult
     out->stage_ns[stage] = now_ns - stamp_ns;
     stamp_ns = now_ns;
   };
-  ++counters_.frames;
   out->estimate = PoseEstimate{};
   out->marker_count = 0;
+  out->rejects = MarkerRejects{};
+  out->noisy = false;
+  out->unit_gains = false;
   out->stage_ns.fill(0);
   rect_count_ = 0;
   pair_count_ = 0;
   if (!usable(frame)) {
-    ++counters_.unusable_frames;
+    out->estimate = refused_estimate(Refusal::kUnusableFrame);
     out->total_ns = monotonic_ns() - start_ns;
     return;
   }
 
   // 1. Classify every pixel (adaptive fused lookup) and build components.
-  if (frame.format != PixelFormat::kGray8 && !classifier_.adapt(frame)) {
-    ++counters_.white_reference_kept;
-  }
-  if (!labeler_.label(frame, classifier_)) ++counters_.run_budget_exceeded;
+  if (frame.format != PixelFormat::kGray8) out->unit_gains = !classifier_.adapt(frame);
+  out->noisy = !labeler_.label(frame, classifier_);
   lap(kStageComponents);
 
   // 2. Rectangle template fit.
@@ -184,15 +194,20 @@ void Pipeline::process(const ImageView& frame, PositioningMode mode, FrameResult
   // 4. Read the dots, check the code against the geometry, emit points.
   for (size_t k = 0; k < pair_count_; ++k) {
     if (out->marker_count == kMaxMarkersPerFrame) {
-      ++counters_.marker_overflow;
+      out->rejects.overflow += static_cast<int>(pair_count_ - k);
       break;
     }
-    if (decode(frame, pairs_[k], &out->markers[out->marker_count])) ++out->marker_count;
+    if (decode(frame, pairs_[k], &out->rejects, &out->markers[out->marker_count]))
+      ++out->marker_count;
   }
   lap(kStageDecoding);
 
   // 5. Positioning.
-  out->estimate = positioner_.solve(std::span(out->markers.data(), out->marker_count), mode);
+  if (out->marker_count == 0) {
+    out->estimate = refused_estimate(refusal_without_markers(*out, pair_count_));
+  } else {
+    out->estimate = positioner_.solve(std::span(out->markers.data(), out->marker_count), mode);
+  }
   lap(kStagePositioning);
   out->total_ns = stamp_ns - start_ns;
 }

@@ -2,7 +2,7 @@
 // The marker localization pipeline of one camera: frame in, decoded markers
 // and pose out, in numbered stages each followed by a time stamp (issue 3).
 // Not thread-safe: one instance per processing thread. process() allocates
-// nothing, throws nothing and logs nothing; it counts what went wrong.
+// nothing, throws nothing and logs nothing; the result says what went wrong.
 #include <array>
 #include <cstdint>
 #include <span>
@@ -29,26 +29,27 @@ enum PipelineStage : int {
   kStageCount
 };
 
-struct FrameResult {
-  PoseEstimate estimate;
-  int marker_count = 0;
-  std::array<MarkerObservation, kMaxMarkersPerFrame> markers{};
-  std::array<int64_t, kStageCount> stage_ns{};  // duration of each stage
-  int64_t total_ns = 0;
+// Rectangle pairs of one frame that were not decoded, by reason. They decide
+// the frame's refusal when no marker decodes.
+struct MarkerRejects {
+  int cut = 0;           // touching the frame border
+  int blurred = 0;       // blur along North too wide for the red dots
+  int unreadable = 0;    // slots outside the frame
+  int ambiguous = 0;     // a slot too close to the dot threshold
+  int inconsistent = 0;  // dark area disagreeing with the code
+  int overflow = 0;      // beyond kMaxMarkersPerFrame
+  int total() const { return cut + blurred + unreadable + ambiguous + inconsistent + overflow; }
 };
 
-// What the pipeline rejected and why, since its start (never reset).
-struct PipelineCounters {
-  uint64_t frames = 0;
-  uint64_t unusable_frames = 0;       // empty, wrong size or format, bad stride
-  uint64_t run_budget_exceeded = 0;   // frames abandoned as noise
-  uint64_t white_reference_kept = 0;  // frames without enough tile to adapt to
-  uint64_t cut_markers = 0;           // pairs touching the frame border, not decoded
-  uint64_t unreadable_codes = 0;      // pairs whose slots fell outside the frame
-  uint64_t ambiguous_codes = 0;       // a slot too close to the dot threshold
-  uint64_t blurred_markers = 0;       // blur along North too wide for the red dots
-  uint64_t inconsistent_markers = 0;  // dark area disagreeing with the code
-  uint64_t marker_overflow = 0;       // frames with more than kMaxMarkersPerFrame
+struct FrameResult {
+  PoseEstimate estimate;  // estimate.refusal says why when invalid
+  int marker_count = 0;
+  std::array<MarkerObservation, kMaxMarkersPerFrame> markers{};
+  MarkerRejects rejects;
+  bool noisy = false;       // the labeler abandoned the frame (run budget exceeded)
+  bool unit_gains = false;  // no tile to take the colour reference from
+  std::array<int64_t, kStageCount> stage_ns{};  // duration of each stage
+  int64_t total_ns = 0;
 };
 
 class Pipeline {
@@ -60,7 +61,7 @@ class Pipeline {
 
   // Processes one frame. A frame of another size than the configured
   // intrinsics, compressed, empty or malformed, gives an invalid estimate
-  // and no markers.
+  // (refusal unusable_frame) and no markers.
   void process(const ImageView& frame, PositioningMode mode, FrameResult* out);
 
   // Replaces the configuration (SIGHUP reload of thresholds); rebuilds the
@@ -71,8 +72,6 @@ class Pipeline {
   static const char* stage_name(int stage);
 
   const PipelineConfig& config() const { return config_; }
-  const PipelineCounters& counters() const { return counters_; }
-  const ColorClassifier& classifier() const { return classifier_; }
   // Intermediate results of the last frame, for tests and diagnostics.
   std::span<const Component> components() const { return labeler_.components(); }
   std::span<const RectangleCandidate> rectangles() const { return {rects_.data(), rect_count_}; }
@@ -80,7 +79,9 @@ class Pipeline {
 
  private:
   bool usable(const ImageView& frame) const;
-  bool decode(const ImageView& frame, const MarkerPair& pair, MarkerObservation* out);
+  bool decode(const ImageView& frame, const MarkerPair& pair, MarkerRejects* rejects,
+              MarkerObservation* out);
+  static Refusal refusal_without_markers(const FrameResult& result, size_t pair_count);
 
   PipelineConfig config_;
   ColorClassifier classifier_;
@@ -92,7 +93,6 @@ class Pipeline {
   std::vector<MarkerPair> pairs_;
   size_t pair_count_ = 0;
   Positioner positioner_;
-  PipelineCounters counters_;
 };
 
 }  // namespace ceilpose

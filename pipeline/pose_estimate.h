@@ -1,9 +1,12 @@
 #pragma once
 #include <array>
 #include <cstdint>
+#include <string>
 #include <string_view>
+#include <vector>
 
 #include "core/pose.h"
+#include "core/refusal.h"
 
 namespace ceilpose {
 
@@ -15,9 +18,16 @@ enum class PositioningMode : uint8_t {
   kLeastSquares = 3
 };
 
-// Names used on the command line and in JSON output: auto, axes, barycentric, lsq.
+inline constexpr std::array<PositioningMode, 4> kPositioningModes{
+    PositioningMode::kAuto, PositioningMode::kChangeOfAxes, PositioningMode::kBarycentric,
+    PositioningMode::kLeastSquares};
+
+// Names used on the command line, in the configuration and in JSON output:
+// auto, axes, barycentric, lsq.
 std::string_view to_string(PositioningMode mode);
 bool parse_positioning_mode(std::string_view text, PositioningMode* mode);
+std::vector<std::string> positioning_mode_names();  // in kPositioningModes order
+std::string positioning_mode_list();                // "auto, axes, barycentric or lsq"
 
 struct PoseEstimate {
   bool valid = false;
@@ -31,6 +41,16 @@ struct PoseEstimate {
   // fewer than two markers. Set on refused estimates too, so that callers can
   // say why a view full of markers gives no pose.
   double depth_scale = 0.0;
+  // Why there is no pose (kNone when valid): set by the stage that refused.
+  Refusal refusal = Refusal::kNone;
 };
+
+// An invalid estimate that says why.
+inline PoseEstimate refused_estimate(Refusal why, double depth_scale = 0.0) {
+  PoseEstimate e;
+  e.refusal = why;
+  e.depth_scale = depth_scale;
+  return e;
+}
 
 }  // namespace ceilpose

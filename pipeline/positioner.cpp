@@ -114,20 +114,31 @@ PoseEstimate Positioner::solve(std::span<const MarkerObservation> markers, Posit
     if (!markers[k].whole) continue;
     if (marker_fix(view_, markers[k], k, &fixes_[fix_count])) ++fix_count;
   }
-  if (fix_count == 1 && markers[fixes_[0].index].quality < kLoneMarkerMinQuality) return {};
+  if (fix_count == 0) return refused_estimate(Refusal::kNoWholeMarker);
+  if (fix_count == 1 && markers[fixes_[0].index].quality < kLoneMarkerMinQuality)
+    return refused_estimate(Refusal::kLoneMarkerUnclear);
   // 2. Keep the markers that agree on where the camera is.
   const int inliers =
       grid_consistent_subset(params_, view_.layout().grid_m, std::span(fixes_.data(), fix_count),
                              std::span(inlier_.data(), fix_count));
-  PoseEstimate est;
-  if (inliers == 0) return est;
+  if (inliers == 0) return refused_estimate(Refusal::kInconsistentMarkers);
   // 3. The configured heights must match what the markers' spacing says.
   const double scale = depth_scale(fix_count);
-  est.depth_scale = scale;
-  if (depth_scale_contradicts_heights(params_, scale)) return est;
+  if (depth_scale_contradicts_heights(params_, scale))
+    return refused_estimate(Refusal::kWrongHeights, scale);
   // 4. The mode asked for, or in auto the best the view allows.
-  est = solve_mode(markers, fix_count, mode);
+  PoseEstimate est = solve_mode(markers, fix_count, mode);
   est.depth_scale = scale;
+  if (!est.valid) {
+    // A solver given fewer markers than it needs did not fail: the view did.
+    int inlier_points = 0;
+    for (int k = 0; k < fix_count; ++k)
+      if (inlier_[k]) inlier_points += markers[fixes_[k].index].point_count;
+    const bool too_few =
+        (mode == PositioningMode::kBarycentric && inliers < 3) ||
+        (mode == PositioningMode::kLeastSquares && inlier_points < params_.lsq_min_points);
+    est.refusal = too_few ? Refusal::kTooFewMarkers : Refusal::kSolverRejected;
+  }
   return est;
 }
 

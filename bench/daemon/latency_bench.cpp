@@ -28,6 +28,7 @@
 #include "config/service_config.h"
 #include "core/clock.h"
 #include "daemon/pipeline_worker.h"
+#include "daemon/shm_pose_sink.h"
 #include "ipc/shm/shm_pose_writer.h"
 #include "recording/recording_writer.h"
 #include "sim/renderer.h"
@@ -132,12 +133,13 @@ void BM_FrameToPose(benchmark::State& state, bool replay) {
       state.SkipWithError(shm.error().message.c_str());
       return;
     }
-    daemon::ProblemCounters problems;
+    daemon::ShmPoseSink shm_sink(&*shm, config.watchdog.status_interval_ms);
+    daemon::PublishingSink* sinks[] = {&shm_sink};
     daemon::ProgressCounter progress;
     daemon::WorkerOptions wopts;
     wopts.rt_priority = config.capture.pipeline_rt_priority;  // as ceilposed runs it
     wopts.latency_warmup_frames = kWarmupFrames;
-    daemon::PipelineWorker worker(config, wopts, &capture, &*shm, nullptr, &problems, &progress);
+    daemon::PipelineWorker worker(config, wopts, &capture, sinks, &progress);
 
     std::unique_ptr<BusyCore> busy;
     if (loaded) busy = std::make_unique<BusyCore>(1);

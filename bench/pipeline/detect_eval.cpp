@@ -153,10 +153,15 @@ int run(const std::string& name, int frame_count) {
   const bool dump = std::getenv("DUMP") != nullptr;
   const bool slots = std::getenv("SLOTS") != nullptr;
   SlotExtremes extremes;
+  MarkerRejects rejects;
   for (size_t index = 0; index < scenario->frames.size(); ++index) {
     const sim::ScenarioFrame& f = scenario->frames[index];
     renderer.render(f.pose, f.mount, f.effects, f.seed, &image);
     pipeline.process(image.view(), PositioningMode::kAuto, &result);
+    rejects.cut += result.rejects.cut;
+    rejects.blurred += result.rejects.blurred;
+    rejects.ambiguous += result.rejects.ambiguous;
+    rejects.inconsistent += result.rejects.inconsistent;
     const CameraPose camera = camera_pose_from_robot(f.pose, f.mount);
     if (slots) extremes.add(pipeline, image.view(), camera);
     const int in_view = sim::count_whole_markers(options, f.pose, f.mount);
@@ -187,17 +192,14 @@ int run(const std::string& name, int frame_count) {
       if (e > 0.25 * config.layout.grid_m) ++gross;
     }
   }
-  const PipelineCounters& c = pipeline.counters();
   std::printf(
       "%-12s frames %4zu | whole markers %5d decoded %5d (%.1f %%) wrong codes %d | centre error "
       "median %.3f p99 %.3f px | valid %d/%d frames, position error median %.2f p99 %.2f mm, "
-      "gross %d | refused: cut %lu blurred %lu ambiguous %lu inconsistent %lu\n",
+      "gross %d | refused: cut %d blurred %d ambiguous %d inconsistent %d\n",
       name.c_str(), scenario->frames.size(), whole, found, whole ? 100.0 * found / whole : 0.0,
       wrong, percentile(centre_err_px, 0.5), percentile(centre_err_px, 0.99), valid,
       frames_with_whole, 1e3 * percentile(pose_err_m, 0.5), 1e3 * percentile(pose_err_m, 0.99),
-      gross, static_cast<unsigned long>(c.cut_markers),
-      static_cast<unsigned long>(c.blurred_markers), static_cast<unsigned long>(c.ambiguous_codes),
-      static_cast<unsigned long>(c.inconsistent_markers));
+      gross, rejects.cut, rejects.blurred, rejects.ambiguous, rejects.inconsistent);
   if (!depth_scale.empty()) {
     // How far the markers' spacing puts the ceiling from the configured
     // heights (positioning refuses beyond max_depth_scale_error).

@@ -1,5 +1,5 @@
-// Speed of Pipeline::process() on simulated ceiling frames with 9–12 whole
-// markers in view, per stage and per frame, at 320×240, 640×480 and
+// Speed of Localizer::localize() (the daemon's per-frame path, filter off) on simulated ceiling
+// frames with 9–12 whole markers in view, per stage and per frame, at 320×240, 640×480 and
 // 1280×960, and of the AprilTag 3 detector (tag36h11, one thread, decimate 2
 // and 1) on grey frames of the same size holding as many tags. Each
 // AprilTag benchmark reports `x_ceilpose`: its median over the pipeline's
@@ -19,7 +19,7 @@
 #include <vector>
 
 #include "core/clock.h"
-#include "pipeline/pipeline.h"
+#include "pipeline/localizer.h"
 #include "sim/renderer.h"
 #include "sim/scenarios.h"
 #include "sim/visibility.h"
@@ -92,8 +92,9 @@ void BM_Pipeline(benchmark::State& state) {
     state.SkipWithError("no frames with 9-12 whole markers");
     return;
   }
-  Pipeline pipeline(config_for(width_px));
-  static FrameResult result;
+  // The daemon's per-frame object, filter off: figures stay per frame.
+  Localizer localizer(config_for(width_px), LocalizerOptions{PositioningMode::kAuto, false});
+  FrameInfo info;
   // Medians, not means: on a shared machine a preempted iteration would
   // otherwise dominate the figure.
   constexpr size_t kMaxSamples = 1 << 16;
@@ -106,17 +107,18 @@ void BM_Pipeline(benchmark::State& state) {
   size_t i = 0;
   for (auto _ : state) {
     const int64_t cpu0_ns = clock_ns(CLOCK_THREAD_CPUTIME_ID);
-    pipeline.process(frames[i++ % frames.size()].view(), PositioningMode::kAuto, &result);
+    info.timestamp_ns += 33'333'333;
+    const Localization& loc = localizer.localize(frames[i++ % frames.size()].view(), info);
     const int64_t cpu_ns = clock_ns(CLOCK_THREAD_CPUTIME_ID) - cpu0_ns;
-    benchmark::DoNotOptimize(result.estimate);
+    benchmark::DoNotOptimize(loc.published);
     if (frame_ns.size() < kMaxSamples) {
       for (int s = 0; s < kStageCount; ++s)
-        stage_ns[s].push_back(static_cast<double>(result.stage_ns[s]));
-      frame_ns.push_back(static_cast<double>(result.total_ns));
+        stage_ns[s].push_back(static_cast<double>(loc.stage_ns[s]));
+      frame_ns.push_back(static_cast<double>(loc.localize_ns));
       frame_cpu_ns.push_back(static_cast<double>(cpu_ns));
     }
-    markers += result.marker_count;
-    valid += result.estimate.valid ? 1.0 : 0.0;
+    markers += loc.markers_decoded;
+    valid += loc.published.valid ? 1.0 : 0.0;
   }
   const double n = static_cast<double>(state.iterations());
   for (int s = 0; s < kStageCount; ++s) {

@@ -87,6 +87,10 @@ void to_message(const DdsStatus& status, const std::string& robot, ceilpose_msg_
   msg->latency_p90_us = status.latency_p90_us;
   msg->latency_p99_us = status.latency_p99_us;
   msg->latency_max_us = status.latency_max_us;
+  constexpr size_t kSlots = sizeof(msg->refusals) / sizeof(msg->refusals[0]);
+  static_assert(kRefusalCount <= kSlots, "ceilpose_status.idl has a slot for every refusal");
+  for (size_t i = 0; i < kSlots; ++i)
+    msg->refusals[i] = i < status.refusals.size() ? status.refusals[i] : 0;
 }
 
 }  // namespace ceilpose

@@ -6,6 +6,7 @@
 #include <new>
 #include <string>
 
+#include "core/refusal.h"
 #include "ipc/shm/pose_record.h"
 #include "ipc/shm/shm_pose_reader.h"
 
@@ -144,6 +145,7 @@ int ceilpose_client_writer_info(ceilpose_client* client, ceilpose_writer_info* o
   out->start_mono_ns = info.start_mono_ns;
   out->start_real_ns = info.start_real_ns;
   out->heartbeat_mono_ns = info.heartbeat_mono_ns;
+  out->stale_after_ms = static_cast<uint32_t>(info.stale_after_ms);
   return CEILPOSE_OK;
 }
 
@@ -159,6 +161,11 @@ int ceilpose_client_read_recent(ceilpose_client* client, ceilpose_pose* out, uin
 }
 
 const char* ceilpose_mode_name(uint8_t mode) { return ceilpose::pose_mode_name(mode); }
+
+// The names are std::string_views over string literals: NUL-terminated.
+const char* ceilpose_refusal_name(unsigned index) {
+  return ceilpose::refusal_name(index > 255 ? -1 : static_cast<int>(index)).data();
+}
 
 const char* ceilpose_strerror(int code) {
   switch (code) {

@@ -4,20 +4,6 @@
 
 namespace ceilpose {
 
-const char* to_string(FixState state) {
-  switch (state) {
-    case FixState::kNone:
-      return "none";
-    case FixState::kOk:
-      return "fix";
-    case FixState::kCoasting:
-      return "coasting";
-    case FixState::kLost:
-      return "lost";
-  }
-  return "unknown";
-}
-
 const char* to_string(WriterState state) {
   switch (state) {
     case WriterState::kStarting:

@@ -6,22 +6,25 @@
 #include <cstdint>
 
 #include "ceilpose/pose_client.h"
+#include "core/fix_state.h"
+#include "core/refusal.h"
 
 namespace ceilpose {
 
 using PoseRecord = ::ceilpose_pose;
 using StatusRecord = ::ceilpose_status;
 
+static_assert(kRefusalCount <= CEILPOSE_REFUSAL_SLOTS, "a status slot for every refusal");
+
 inline constexpr uint32_t kPoseValid = CEILPOSE_POSE_VALID;
 inline constexpr uint32_t kPoseFiltered = CEILPOSE_POSE_FILTERED;
 inline constexpr uint32_t kPoseCoasting = CEILPOSE_POSE_COASTING;
 
-enum class FixState : uint32_t {
-  kNone = CEILPOSE_FIX_NONE,
-  kOk = CEILPOSE_FIX_OK,
-  kCoasting = CEILPOSE_FIX_COASTING,
-  kLost = CEILPOSE_FIX_LOST,
-};
+static_assert(static_cast<uint32_t>(FixState::kNone) == CEILPOSE_FIX_NONE &&
+                  static_cast<uint32_t>(FixState::kOk) == CEILPOSE_FIX_OK &&
+                  static_cast<uint32_t>(FixState::kCoasting) == CEILPOSE_FIX_COASTING &&
+                  static_cast<uint32_t>(FixState::kLost) == CEILPOSE_FIX_LOST,
+              "core/fix_state.h and the C client agree");
 
 enum class WriterState : uint32_t {
   kStarting = CEILPOSE_STATE_STARTING,
@@ -30,7 +33,6 @@ enum class WriterState : uint32_t {
 };
 
 // Names used by ceilposectl (human and JSON output).
-const char* to_string(FixState state);
 const char* to_string(WriterState state);
 // SPEC §5 mode names: auto, axes, barycentric, lsq; "unknown" otherwise.
 const char* pose_mode_name(uint8_t mode);

@@ -108,6 +108,9 @@ struct alignas(64) SegmentHeader {
   std::atomic<uint32_t> wake_seq;
   std::atomic<int64_t> heartbeat_mono_ns;
   std::atomic<uint64_t> latest_seq;  // seq of the pose in `latest`, 0 before the first
+  // The writer's ipc.stale_after_ms: what readers call stale unless told
+  // otherwise. Written once, before `magic`.
+  uint32_t stale_after_ms;
 };
 
 struct Segment {
@@ -135,9 +138,10 @@ static_assert(offsetof(SegmentHeader, state) == 64, "layout of docs/ipc.md");
 static_assert(offsetof(SegmentHeader, wake_seq) == 68, "layout of docs/ipc.md");
 static_assert(offsetof(SegmentHeader, heartbeat_mono_ns) == 72, "layout of docs/ipc.md");
 static_assert(offsetof(SegmentHeader, latest_seq) == 80, "layout of docs/ipc.md");
-static_assert(offsetof(Segment, ring) == 512, "layout of docs/ipc.md");
+static_assert(offsetof(SegmentHeader, stale_after_ms) == 88, "layout of docs/ipc.md");
+static_assert(offsetof(Segment, ring) == 640, "layout of docs/ipc.md");
 static_assert(sizeof(SeqlockSlot<PoseRecord>) == 192, "layout of docs/ipc.md");
-static_assert(sizeof(SeqlockSlot<StatusRecord>) == 192, "layout of docs/ipc.md");
-static_assert(sizeof(Segment) == 128 + 192 * (2 + kRingLength), "layout of docs/ipc.md");
+static_assert(sizeof(SeqlockSlot<StatusRecord>) == 320, "layout of docs/ipc.md");
+static_assert(sizeof(Segment) == 128 + 192 + 320 + 192 * kRingLength, "layout of docs/ipc.md");
 
 }  // namespace ceilpose::shm

@@ -349,7 +349,7 @@ Liveness ShmPoseReader::liveness(int64_t stale_after_ms) const {
   if (state == WriterState::kStopped) return Liveness::kStopped;
   if (!shm::process_exists(h.writer_pid)) return Liveness::kWriterDead;
   const int64_t age_ns = monotonic_ns() - h.heartbeat_mono_ns.load(std::memory_order_acquire);
-  if (age_ns > stale_after_ms * 1'000'000) return Liveness::kStale;
+  if (age_ns > this->stale_after_ms(stale_after_ms) * 1'000'000) return Liveness::kStale;
   if (state == WriterState::kStarting) return Liveness::kStarting;
   return Liveness::kLive;
 }
@@ -375,7 +375,12 @@ WriterInfo ShmPoseReader::writer_info() const {
   info.start_mono_ns = h.start_mono_ns;
   info.start_real_ns = h.start_real_ns;
   info.heartbeat_mono_ns = h.heartbeat_mono_ns.load(std::memory_order_acquire);
+  info.stale_after_ms = h.stale_after_ms;
   return info;
+}
+
+int64_t ShmPoseReader::stale_after_ms(int64_t requested) const {
+  return requested > 0 ? requested : int64_t{impl_->header().stale_after_ms};
 }
 
 uint64_t ShmPoseReader::latest_seq() const { return impl_->latest_seq(); }

@@ -37,10 +37,8 @@ struct WriterInfo {
   int64_t start_mono_ns = 0;
   int64_t start_real_ns = 0;
   int64_t heartbeat_mono_ns = 0;
+  int64_t stale_after_ms = 0;  // the writer's staleness threshold (ipc.stale_after_ms)
 };
-
-// A sensible staleness threshold: 20 missed heartbeats at the default period.
-inline constexpr int64_t kDefaultStaleAfterMs = 1000;
 
 class ShmPoseReader {
  public:
@@ -64,7 +62,10 @@ class ShmPoseReader {
   // Blocks on the futex until a pose with seq > after_seq exists (returns the
   // newest), the writer stops or dies, or timeout_ms passes (< 0: forever).
   WaitResult wait_next(uint64_t after_seq, int timeout_ms, PoseRecord* out);
-  Liveness liveness(int64_t stale_after_ms) const;
+  // stale_after_ms <= 0: the writer's own threshold (WriterInfo::stale_after_ms).
+  Liveness liveness(int64_t stale_after_ms = 0) const;
+  // `requested` when positive, else the writer's threshold.
+  int64_t stale_after_ms(int64_t requested = 0) const;
   ReadResult read_status(StatusRecord* out) const;
   // Up to max_poses recent poses, newest first; returns how many.
   int read_recent(PoseRecord* out, int max_poses) const;

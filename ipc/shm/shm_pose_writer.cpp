@@ -8,6 +8,7 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cerrno>
 #include <condition_variable>
 #include <mutex>
@@ -322,6 +323,7 @@ Result<ShmPoseWriter> ShmPoseWriter::create(const ShmOptions& options, ShmErrc* 
   h.start_real_ns = realtime_ns();
   h.state.store(static_cast<uint32_t>(WriterState::kStarting), std::memory_order_relaxed);
   h.heartbeat_mono_ns.store(h.start_mono_ns, std::memory_order_relaxed);
+  h.stale_after_ms = static_cast<uint32_t>(std::max(1, options.stale_after_ms));
   h.magic.store(shm::kMagic, std::memory_order_release);
 
   impl->fd = std::move(fd);

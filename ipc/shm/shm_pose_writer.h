@@ -31,6 +31,9 @@ struct ShmOptions {
   // judge staleness against a threshold well above it. 0: no thread, the
   // caller must call heartbeat() at least every 100 ms.
   int heartbeat_period_ms = 50;
+  // Published in the segment: readers call a heartbeat or pose older than
+  // this stale unless they are given their own threshold (ipc.stale_after_ms).
+  int stale_after_ms = 500;
 };
 
 class ShmPoseWriter {

@@ -6,6 +6,8 @@
 
 #include <sstream>
 
+#include "daemon/problem_report.h"
+
 namespace ceilpose::daemon {
 namespace {
 
@@ -33,31 +35,33 @@ TEST(JournalPrefix, MapsLevelsToSdDaemonPriorities) {
   EXPECT_STREQ(journal_prefix(spdlog::level::critical), SD_CRIT);
 }
 
-TEST(ProblemCounters, ReportsManyFramesAsOneLine) {
-  CapturedLog log;
-  ProblemCounters counters;
-  for (int i = 0; i < 1000; ++i) counters.count(Problem::kNoMarkers);
-  counters.count(Problem::kPublishFailed);
-  counters.report(10.0);
-  const std::string text = log.text();
-  EXPECT_EQ(std::count(text.begin(), text.end(), '\n'), 1) << text;
-  EXPECT_NE(text.find("1000 frames without a decoded marker"), std::string::npos) << text;
-  EXPECT_NE(text.find("1 DDS writes failed"), std::string::npos) << text;
+RefusalHistogram::Counts counts_with(std::initializer_list<std::pair<Refusal, uint64_t>> counts) {
+  RefusalHistogram::Counts c{};
+  for (const auto& [r, n] : counts) c[static_cast<size_t>(r)] = n;
+  return c;
 }
 
-TEST(ProblemCounters, ReportsOnlyWhatGrewSinceTheLastReport) {
+TEST(ProblemReport, ReportsManyFramesAsOneLineWithTheRefusalsDescription) {
   CapturedLog log;
-  ProblemCounters counters;
-  counters.count(Problem::kNoMarkers);
-  counters.report(10.0);
-  counters.report(10.0);  // nothing new: silent
-  counters.count(Problem::kInvalidPose);
-  counters.report(10.0);
+  ProblemReport report;
+  report.report(counts_with({{Refusal::kNone, 50}, {Refusal::kNoMarkers, 1000}}), 1, 10.0);
   const std::string text = log.text();
-  EXPECT_EQ(std::count(text.begin(), text.end(), '\n'), 2) << text;
-  EXPECT_EQ(text.find("frames without a decoded marker", text.find('\n')), std::string::npos)
+  EXPECT_EQ(std::count(text.begin(), text.end(), '\n'), 1) << text;
+  EXPECT_NE(text.find("last 10.0 s: 1000 " + std::string(describe(Refusal::kNoMarkers))),
+            std::string::npos)
       << text;
-  EXPECT_EQ(counters.total(Problem::kNoMarkers), 1u);
+  EXPECT_NE(text.find(", 1 DDS writes failed"), std::string::npos) << text;
+  EXPECT_EQ(text.find(std::string(describe(Refusal::kNone))), std::string::npos)
+      << "frames with a pose are no problem: " << text;
+}
+
+TEST(ProblemReport, ReportsOnlyWhatGrewSinceTheLastReport) {
+  ProblemReport report;
+  EXPECT_EQ(report.update(counts_with({{Refusal::kNoMarkers, 1}}), 0),
+            "1 " + std::string(describe(Refusal::kNoMarkers)));
+  EXPECT_EQ(report.update(counts_with({{Refusal::kNoMarkers, 1}}), 0), "") << "nothing new";
+  EXPECT_EQ(report.update(counts_with({{Refusal::kNoMarkers, 1}, {Refusal::kWrongHeights, 3}}), 0),
+            "3 " + std::string(describe(Refusal::kWrongHeights)));
 }
 
 }  // namespace

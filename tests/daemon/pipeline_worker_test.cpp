@@ -12,6 +12,7 @@
 
 #include "capture/capture_thread.h"
 #include "capture/frame_source.h"
+#include "daemon/shm_pose_sink.h"
 #include "ipc/shm/shm_pose_reader.h"
 #include "ipc/shm/shm_pose_writer.h"
 
@@ -37,6 +38,8 @@ struct Rig {
     auto w = ShmPoseWriter::create(sopts);
     if (!w) throw std::runtime_error(w.error().message);
     shm.emplace(std::move(w).value());
+    shm_sink.emplace(&*shm, status_interval_ms);
+    sinks.push_back(&*shm_sink);
   }
   ~Rig() {
     capture->stop();
@@ -48,7 +51,9 @@ struct Rig {
   std::string shm_name = "/ceilpose-worker-test-" + std::to_string(getpid());
   std::unique_ptr<capture::CaptureThread> capture;
   std::optional<ShmPoseWriter> shm;
-  ProblemCounters problems;
+  int status_interval_ms = 50;
+  std::optional<ShmPoseSink> shm_sink;
+  std::vector<PublishingSink*> sinks;
   ProgressCounter progress;
 };
 
@@ -61,8 +66,7 @@ bool wait_frames(const PipelineWorker& worker, uint64_t n) {
 
 TEST(PipelineWorker, PublishesEveryProcessedFrameAndCountsProgress) {
   Rig rig;
-  PipelineWorker worker(rig.config, WorkerOptions{}, rig.capture.get(), &*rig.shm, nullptr,
-                        &rig.problems, &rig.progress);
+  PipelineWorker worker(rig.config, WorkerOptions{}, rig.capture.get(), rig.sinks, &rig.progress);
   worker.start();
   ASSERT_TRUE(wait_frames(worker, 10));
   worker.stop();
@@ -74,8 +78,7 @@ TEST(PipelineWorker, PublishesEveryProcessedFrameAndCountsProgress) {
 
 TEST(PipelineWorker, SnapshotsAndReloadsFromAnotherThreadKeepTheSequenceRising) {
   Rig rig;
-  PipelineWorker worker(rig.config, WorkerOptions{}, rig.capture.get(), &*rig.shm, nullptr,
-                        &rig.problems, &rig.progress);
+  PipelineWorker worker(rig.config, WorkerOptions{}, rig.capture.get(), rig.sinks, &rig.progress);
   worker.start();
   ASSERT_TRUE(wait_frames(worker, 2));
   uint64_t last_seq = 0;
@@ -84,8 +87,8 @@ TEST(PipelineWorker, SnapshotsAndReloadsFromAnotherThreadKeepTheSequenceRising) 
     changed.pipeline.detector.min_rect_area_px = (i % 2 == 0) ? 1 << 23 : 150;
     worker.reload(changed, i % 3 == 0);
     const PoseSnapshot s = worker.latest();
-    EXPECT_GE(s.seq, last_seq);
-    last_seq = s.seq;
+    EXPECT_GE(s.frame, last_seq);
+    last_seq = s.frame;
     std::this_thread::sleep_for(std::chrono::milliseconds(20));
   }
   const uint64_t before = worker.frames();
@@ -96,10 +99,7 @@ TEST(PipelineWorker, SnapshotsAndReloadsFromAnotherThreadKeepTheSequenceRising) 
 
 TEST(PipelineWorker, StatusRecordReachesReaders) {
   Rig rig;
-  WorkerOptions options;
-  options.status_interval_ms = 50;
-  PipelineWorker worker(rig.config, options, rig.capture.get(), &*rig.shm, nullptr, &rig.problems,
-                        &rig.progress);
+  PipelineWorker worker(rig.config, WorkerOptions{}, rig.capture.get(), rig.sinks, &rig.progress);
   worker.start();
   ASSERT_TRUE(wait_frames(worker, 10));
   auto reader = ShmPoseReader::open(rig.shm_name);
@@ -116,6 +116,47 @@ TEST(PipelineWorker, StatusRecordReachesReaders) {
   ASSERT_TRUE(seen) << "no status with frames and a positive fps within 3 s; last fps "
                     << status.fps << ", frames " << status.frames;
   EXPECT_NE(std::string(status.source).find("synthetic"), std::string::npos) << status.source;
+  // Every localized frame is in the refusal histogram, under its reason.
+  EXPECT_EQ(status.refusal_count, static_cast<uint32_t>(kRefusalCount));
+  uint64_t counted = 0;
+  for (uint32_t i = 0; i < status.refusal_count; ++i) counted += status.refusals[i];
+  EXPECT_GT(counted, 0u);
+  EXPECT_LE(counted, worker.frames());
+  EXPECT_GT(status.refusals[0], 0u) << "the synthetic ceiling gives poses";
+}
+
+TEST(PipelineWorker, EveryFrameReachesEverySinkWithItsRefusal) {
+  // A sink that records what it was given, checked after stop() (the worker
+  // thread is then joined: no race on the fields).
+  struct CountingSink final : PublishingSink {
+    void consume(const Localization& loc) override {
+      ++frames;
+      if (!loc.published.valid && loc.published.refusal == Refusal::kNone) ++invalid_without_reason;
+      if (loc.published.valid) ++valid;
+    }
+    void publish_status(const ServiceStatus& s) override {
+      ++statuses;
+      last_refusals = s.refusals;
+    }
+    int64_t status_period_ns() const override { return 20'000'000; }
+    uint64_t frames = 0, valid = 0, invalid_without_reason = 0, statuses = 0;
+    RefusalHistogram::Counts last_refusals{};
+  };
+  Rig rig;
+  CountingSink counting;
+  rig.sinks.push_back(&counting);
+  PipelineWorker worker(rig.config, WorkerOptions{}, rig.capture.get(), rig.sinks, &rig.progress);
+  worker.start();
+  ASSERT_TRUE(wait_frames(worker, 10));
+  worker.stop();
+  EXPECT_EQ(counting.frames, worker.frames());
+  EXPECT_EQ(rig.shm->last_seq(), worker.frames()) << "the shared memory sink saw the same frames";
+  EXPECT_GT(counting.valid, 0u);
+  EXPECT_EQ(counting.invalid_without_reason, 0u);
+  EXPECT_GE(counting.statuses, 1u) << "the final status is always published";
+  uint64_t counted = 0;
+  for (uint64_t n : counting.last_refusals) counted += n;
+  EXPECT_EQ(counted, worker.frames()) << "the last status holds every frame's refusal";
 }
 
 }  // namespace

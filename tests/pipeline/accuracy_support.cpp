@@ -3,10 +3,8 @@
 #include <gtest/gtest.h>
 
 #include <cstdlib>
-#include <memory>
 
-#include "pipeline/pipeline.h"
-#include "pipeline/temporal_filter.h"
+#include "pipeline/localizer.h"
 #include "sim/renderer.h"
 #include "sim/scenarios.h"
 #include "sim/visibility.h"
@@ -42,19 +40,24 @@ AccuracyReport run_scenario(const std::string& name, int frames, uint64_t seed,
     return {};
   }
   sim::Renderer renderer(options);
-  Pipeline pipeline(config);
-  TemporalFilter temporal(config.filter);
-  auto result = std::make_unique<FrameResult>();
-  AccuracyAccumulator acc(config.layout.grid_m);
+  // The scenario's mount may differ per frame: the sink asks about the frame
+  // being scored.
+  const sim::ScenarioFrame* current = nullptr;
+  AccuracySink accuracy(config.layout.grid_m, [&](const Pose2D& truth) {
+    return sim::count_whole_markers(options, truth, current->mount) > 0;
+  });
+  Localizer localizer(config, LocalizerOptions{mode, filter});
   Image image;
   for (const sim::ScenarioFrame& f : scenario->frames) {
     renderer.render(f.pose, f.mount, f.effects, f.seed, &image);
-    pipeline.process(image.view(), mode, result.get());
-    const PoseEstimate estimate =
-        filter ? temporal.update(result->estimate, f.timestamp_ns) : result->estimate;
-    acc.add(f.pose, sim::count_whole_markers(options, f.pose, f.mount) > 0, estimate);
+    current = &f;
+    FrameInfo info;
+    info.timestamp_ns = f.timestamp_ns;
+    info.has_ground_truth = true;
+    info.ground_truth = f.pose;
+    accuracy.consume(localizer.localize(image.view(), info));
   }
-  return acc.report();
+  return accuracy.report();
 }
 
 }  // namespace ceilpose::testing

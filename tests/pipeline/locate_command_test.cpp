@@ -129,11 +129,13 @@ TEST_F(LocateCommand, PrintsOneSpecJsonLinePerFrameWithAccuratePoses) {
     EXPECT_NE(l.find("\"mode\":\"lsq\""), std::string::npos) << l;
     EXPECT_GE(field(l, "markers"), 3.0) << l;
     EXPECT_GE(field(l, "proc_us"), 0.0) << l;
+    EXPECT_NE(l.find("\"refusal\":null"), std::string::npos) << l;
   }
   const std::string& off = out.back();
   EXPECT_NE(off.find("\"valid\":false,\"x_m\":null,\"y_m\":null,\"yaw_rad\":null"),
             std::string::npos)
       << off;
+  EXPECT_NE(off.find("\"refusal\":\"no_markers\""), std::string::npos) << off;
   EXPECT_TRUE(r.err.empty()) << "stderr is not a terminal: no progress expected: " << r.err;
 }
 
@@ -212,7 +214,10 @@ TEST_F(LocateCommand, HeightsThatDisagreeWithTheMarkersGiveNoPoseAndSaySo) {
   ASSERT_EQ(r.exit_code, 0) << r.err;
   auto out = lines(r.out);
   ASSERT_EQ(out.size(), poses.size());
-  for (const auto& l : out) EXPECT_NE(l.find("\"valid\":false"), std::string::npos) << l;
+  for (const auto& l : out) {
+    EXPECT_NE(l.find("\"valid\":false"), std::string::npos) << l;
+    EXPECT_NE(l.find("\"refusal\":\"wrong_heights\""), std::string::npos) << l;
+  }
   for (const char* word :
        {"warning", "2.500 m", "2.134 m", "ceiling.height_m", "mount.lens_height_m", "--config"}) {
     EXPECT_NE(r.err.find(word), std::string::npos) << word << " in: " << r.err;

@@ -67,6 +67,7 @@ TEST(Positioning, HeightsThatDisagreeWithTheMarkersSpacingAreRefused) {
        {PositioningMode::kAuto, PositioningMode::kLeastSquares, PositioningMode::kBarycentric}) {
     const PoseEstimate est = positioner.solve(markers, mode);
     EXPECT_FALSE(est.valid);
+    EXPECT_EQ(est.refusal, Refusal::kWrongHeights);
     EXPECT_NEAR(est.depth_scale, 2.5 / (2.4384 - 0.3048), 0.01);
   }
 
@@ -82,7 +83,9 @@ TEST(Positioning, NoMarkersGivesInvalidPose) {
   Positioner positioner(config);
   for (auto mode : {PositioningMode::kAuto, PositioningMode::kChangeOfAxes,
                     PositioningMode::kBarycentric, PositioningMode::kLeastSquares}) {
-    EXPECT_FALSE(positioner.solve({}, mode).valid);
+    const PoseEstimate est = positioner.solve({}, mode);
+    EXPECT_FALSE(est.valid);
+    EXPECT_EQ(est.refusal, Refusal::kNoWholeMarker) << to_string(mode);
   }
 }
 
@@ -96,7 +99,9 @@ TEST(Positioning, OnlyPartialMarkersGivesInvalidPose) {
   for (const auto& m : markers)
     if (!m.whole) partial.push_back(m);
   ASSERT_FALSE(partial.empty());
-  EXPECT_FALSE(positioner.solve(partial, PositioningMode::kAuto).valid);
+  const PoseEstimate est = positioner.solve(partial, PositioningMode::kAuto);
+  EXPECT_FALSE(est.valid);
+  EXPECT_EQ(est.refusal, Refusal::kNoWholeMarker);
 }
 
 TEST(Positioning, TwoDisagreeingMarkersGiveInvalidPose) {
@@ -106,7 +111,41 @@ TEST(Positioning, TwoDisagreeingMarkersGiveInvalidPose) {
   auto markers = testing::observe(view, {2.0, 2.0, 0.3});
   markers.resize(2);
   markers[0].code_i ^= 4;
-  EXPECT_FALSE(positioner.solve(markers, PositioningMode::kAuto).valid);
+  const PoseEstimate est = positioner.solve(markers, PositioningMode::kAuto);
+  EXPECT_FALSE(est.valid);
+  EXPECT_EQ(est.refusal, Refusal::kInconsistentMarkers);
+}
+
+TEST(Positioning, ARequestedModeTheViewCannotServeIsTooFewMarkers) {
+  PipelineConfig config;
+  Positioner positioner(config);
+  testing::SyntheticView view;
+  auto markers = testing::observe(view, {2.0, 2.0, 0.3});
+  markers.resize(2);
+  PoseEstimate est = positioner.solve(markers, PositioningMode::kBarycentric);
+  EXPECT_FALSE(est.valid);
+  EXPECT_EQ(est.refusal, Refusal::kTooFewMarkers);
+  config.positioning.lsq_min_points = 1000;
+  Positioner strict(config);
+  est = strict.solve(markers, PositioningMode::kLeastSquares);
+  EXPECT_FALSE(est.valid);
+  EXPECT_EQ(est.refusal, Refusal::kTooFewMarkers);
+  EXPECT_EQ(strict.solve(markers, PositioningMode::kAuto).refusal, Refusal::kNone)
+      << "auto falls back to a thesis mode";
+}
+
+TEST(Positioning, ALoneMarkerWithUnclearDotsIsRefusedAsSuch) {
+  PipelineConfig config;
+  Positioner positioner(config);
+  testing::SyntheticView view;
+  auto markers = testing::observe(view, {2.0, 2.0, 0.3});
+  markers.resize(1);
+  markers[0].quality = 0.3f;
+  const PoseEstimate est = positioner.solve(markers, PositioningMode::kAuto);
+  EXPECT_FALSE(est.valid);
+  EXPECT_EQ(est.refusal, Refusal::kLoneMarkerUnclear);
+  markers[0].quality = 0.9f;
+  EXPECT_TRUE(positioner.solve(markers, PositioningMode::kAuto).valid);
 }
 
 TEST(Positioning, OutlierMarkerDoesNotMoveAnyMode) {
@@ -122,6 +161,7 @@ TEST(Positioning, OutlierMarkerDoesNotMoveAnyMode) {
                     PositioningMode::kBarycentric, PositioningMode::kLeastSquares}) {
     const PoseEstimate est = positioner.solve(markers, mode);
     ASSERT_TRUE(est.valid) << to_string(mode);
+    EXPECT_EQ(est.refusal, Refusal::kNone);
     EXPECT_LT(std::hypot(est.pose.x_m - robot.x_m, est.pose.y_m - robot.y_m), 1e-6)
         << to_string(mode);
   }

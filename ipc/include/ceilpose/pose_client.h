@@ -30,12 +30,14 @@ extern "C" {
 
 /* Version of the shared-segment layout and of these records. A reader refuses
  * a segment of another version (CEILPOSE_ERR_ABI_MISMATCH). */
-#define CEILPOSE_CLIENT_ABI_VERSION 1
+#define CEILPOSE_CLIENT_ABI_VERSION 2
 /* Default segment name (SPEC §7: --shm defaults to /ceilpose). */
 #define CEILPOSE_DEFAULT_SHM_NAME "/ceilpose"
 /* Poses kept in the segment's ring of recent poses. */
 #define CEILPOSE_POSE_RING_LENGTH 64
 #define CEILPOSE_SOURCE_TEXT_SIZE 96
+/* Slots of ceilpose_status.refusals: room for refusal reasons added later. */
+#define CEILPOSE_REFUSAL_SLOTS 16
 
 /* ceilpose_pose.flags */
 #define CEILPOSE_POSE_VALID 0x1u    /* x_m, y_m, yaw_rad and covariance hold a pose */
@@ -72,8 +74,8 @@ typedef struct ceilpose_pose {
   double covariance[9]; /* (x_m, y_m, yaw_rad) row-major, SI units squared */
   uint32_t flags;       /* CEILPOSE_POSE_* */
   uint8_t mode;         /* enum ceilpose_mode */
-  uint8_t reserved0;
-  uint16_t markers; /* decoded markers used */
+  uint8_t refusal;      /* why the frame gave no measurement: ceilpose_refusal_name(); 0 "none" */
+  uint16_t markers;     /* decoded markers used */
 } ceilpose_pose;
 
 /* Daemon health, what `ceilposectl status` shows. Filled by the daemon about
@@ -92,6 +94,12 @@ typedef struct ceilpose_status {
   uint32_t reserved0;
   int64_t updated_mono_ns;                /* when the daemon filled this record */
   char source[CEILPOSE_SOURCE_TEXT_SIZE]; /* NUL-terminated, e.g. "v4l2:/dev/video0" */
+  /* Frames per refusal reason since the daemon started: refusals[i] counts
+   * the reason ceilpose_refusal_name(i) ("none": frames that gave a pose);
+   * the first refusal_count slots are used. */
+  uint32_t refusal_count;
+  uint32_t reserved1;
+  uint64_t refusals[CEILPOSE_REFUSAL_SLOTS];
 } ceilpose_status;
 
 /* Writer state in the segment header. */
@@ -118,6 +126,8 @@ typedef struct ceilpose_writer_info {
   int64_t start_mono_ns;
   int64_t start_real_ns;
   int64_t heartbeat_mono_ns; /* last sign of life, CLOCK_MONOTONIC */
+  uint32_t stale_after_ms;   /* the daemon's ipc.stale_after_ms */
+  uint32_t reserved0;
 } ceilpose_writer_info;
 
 /* Return codes: 0 success, negative errors. */
@@ -163,7 +173,8 @@ int ceilpose_client_wait_next(ceilpose_client* client, uint64_t after_seq, int32
                               ceilpose_pose* out);
 
 /* Judges the writer: stopped, dead (pid gone), stale (heartbeat older than
- * stale_after_ms), restarted (the name now holds another generation) or live. */
+ * stale_after_ms; 0 = the daemon's own ipc.stale_after_ms, published in the
+ * segment), restarted (the name now holds another generation) or live. */
 int ceilpose_client_liveness(ceilpose_client* client, int64_t stale_after_ms,
                              enum ceilpose_liveness* out);
 
@@ -189,6 +200,10 @@ const char* ceilpose_strerror(int code);
  * "auto", "axes", "barycentric", "lsq"; "unknown" otherwise. */
 const char* ceilpose_mode_name(uint8_t mode);
 
+/* snake_case name of refusal reason `index` (SPEC §5 "refusal" of locate):
+ * "none", "unusable_frame", "no_markers", ...; "unknown" beyond the last. */
+const char* ceilpose_refusal_name(unsigned index);
+
 /* Detailed message of the last failed call in this thread (names the segment,
  * its size and mode where relevant); "" if none. */
 const char* ceilpose_last_error_message(void);
@@ -204,7 +219,8 @@ CEILPOSE_STATIC_ASSERT(offsetof(ceilpose_pose, x_m) == 40, "ceilpose_pose.x_m of
 CEILPOSE_STATIC_ASSERT(offsetof(ceilpose_pose, covariance) == 64, "ceilpose_pose.covariance");
 CEILPOSE_STATIC_ASSERT(offsetof(ceilpose_pose, flags) == 136, "ceilpose_pose.flags offset");
 CEILPOSE_STATIC_ASSERT(offsetof(ceilpose_pose, markers) == 142, "ceilpose_pose.markers offset");
-CEILPOSE_STATIC_ASSERT(sizeof(ceilpose_status) == 168, "ceilpose_status layout");
+CEILPOSE_STATIC_ASSERT(sizeof(ceilpose_status) == 304, "ceilpose_status layout");
+CEILPOSE_STATIC_ASSERT(offsetof(ceilpose_status, refusals) == 176, "ceilpose_status.refusals");
 CEILPOSE_STATIC_ASSERT(offsetof(ceilpose_status, latency_p50_us) == 40, "status latency offset");
 CEILPOSE_STATIC_ASSERT(offsetof(ceilpose_status, updated_mono_ns) == 64, "status time offset");
 CEILPOSE_STATIC_ASSERT(offsetof(ceilpose_status, source) == 72, "ceilpose_status.source");

@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "core/clock.h"
+#include "core/refusal.h"
 #include "ipc/shm/shm_pose_reader.h"
 #include "ipc/shm/shm_pose_writer.h"
 #include "shm_test_support.h"
@@ -143,6 +144,10 @@ TEST_F(CtlCommands, StatusJsonShowsDaemonHealth) {
   s.latency_p99_us = 7300;
   s.latency_max_us = 9900;
   s.fix_state = CEILPOSE_FIX_OK;
+  s.refusal_count = kRefusalCount;
+  s.refusals[static_cast<int>(Refusal::kNone)] = 990;
+  s.refusals[static_cast<int>(Refusal::kNoMarkers)] = 7;
+  s.refusals[static_cast<int>(Refusal::kWrongHeights)] = 3;
   set_status_source(&s, "v4l2:/dev/video0");
   writer().update_status(s);
   writer().publish(sample_pose(1));
@@ -151,21 +156,45 @@ TEST_F(CtlCommands, StatusJsonShowsDaemonHealth) {
        {"\"state\":\"running\"", "\"liveness\":\"live\"", "\"fps\":29.50", "\"frames\":1000",
         "\"drops\":2", "\"skipped\":3", "\"outages\":1", "\"p50\":4100", "\"p90\":5200",
         "\"p99\":7300", "\"max\":9900", "\"fix\":\"fix\"", "\"source\":\"v4l2:/dev/video0\"",
-        "\"last_seq\":1"}) {
+        "\"last_seq\":1", "\"refusals\":{\"unusable_frame\":0,", "\"no_markers\":7,",
+        "\"wrong_heights\":3,", "\"localized\":990"}) {
     EXPECT_TRUE(contains(out_, field)) << field << " missing in " << out_;
   }
   EXPECT_TRUE(contains(out_, "\"pid\":" + std::to_string(::getpid()))) << out_;
 }
 
-TEST_F(CtlCommands, StatusHumanOutputNamesSourceAndLatency) {
+TEST_F(CtlCommands, StatusHumanOutputNamesSourceLatencyAndRefusals) {
   ASSERT_NO_FATAL_FAILURE(start());
   StatusRecord s{};
   s.latency_p99_us = 7300;
+  s.refusal_count = kRefusalCount;
+  s.refusals[static_cast<int>(Refusal::kUnreadableMarkers)] = 12;
   set_status_source(&s, "synthetic");
   writer().update_status(s);
   EXPECT_EQ(run({"status", "--shm", name(), "--stale-ms", kLenientStaleMs}), 0) << err_;
   EXPECT_TRUE(contains(out_, "synthetic")) << out_;
   EXPECT_TRUE(contains(out_, "p99 7.30 ms")) << out_;
+  EXPECT_TRUE(contains(out_, "no pose    unreadable_markers 12  (frames per refusal")) << out_;
+}
+
+TEST_F(CtlCommands, PoseJudgesStalenessByTheDaemonsPublishedLimit) {
+  // The writer says 200 ms (ipc.stale_after_ms); a pose 2 s old is stale
+  // without --stale-ms, and the message names the daemon's limit.
+  ASSERT_NO_FATAL_FAILURE(start(50, 200));
+  EXPECT_EQ(reader().writer_info().stale_after_ms, 200);
+  PoseRecord p = sample_pose(1);
+  p.publish_mono_ns = monotonic_ns() - 2'000'000'000;
+  writer().publish(p);
+  EXPECT_EQ(run({"pose", "--shm", name()}), kExitNoDaemon);
+  EXPECT_TRUE(contains(err_, "limit 200 ms")) << err_;
+}
+
+TEST_F(CtlCommands, PoseTakesALenientDaemonLimitToo) {
+  ASSERT_NO_FATAL_FAILURE(start(50, 600'000));
+  PoseRecord p = sample_pose(1);
+  p.publish_mono_ns = monotonic_ns() - 2'000'000'000;
+  writer().publish(p);
+  EXPECT_EQ(run({"pose", "--shm", name()}), 0) << err_;
 }
 
 TEST_F(CtlCommands, StatusSaysStoppedAndExitsNoDaemonAfterCleanStop) {

@@ -75,9 +75,9 @@ TEST_F(ShmLifecycle, NewSegmentIsStartingUntilFirstPoseThenLive) {
   ASSERT_NO_FATAL_FAILURE(start());
   PoseRecord p;
   EXPECT_EQ(reader().read_latest(&p), ReadResult::kNoPose);
-  EXPECT_EQ(reader().liveness(kDefaultStaleAfterMs), Liveness::kStarting);
+  EXPECT_EQ(reader().liveness(), Liveness::kStarting);
   writer().publish(check_pose(1));
-  EXPECT_EQ(reader().liveness(kDefaultStaleAfterMs), Liveness::kLive);
+  EXPECT_EQ(reader().liveness(), Liveness::kLive);
   EXPECT_EQ(reader().writer_info().pid, ::getpid());
   EXPECT_EQ(reader().writer_info().state, WriterState::kRunning);
 }
@@ -86,7 +86,7 @@ TEST_F(ShmLifecycle, MarkStoppedIsSeenAsStoppedAndSegmentStays) {
   ASSERT_NO_FATAL_FAILURE(start());
   writer().publish(check_pose(1));
   writer().mark_stopped();
-  EXPECT_EQ(reader().liveness(kDefaultStaleAfterMs), Liveness::kStopped);
+  EXPECT_EQ(reader().liveness(), Liveness::kStopped);
   PoseRecord p;
   EXPECT_EQ(reader().wait_next(1, 5'000, &p), WaitResult::kStopped);
   // The last pose stays readable after a clean stop.
@@ -165,10 +165,10 @@ TEST_F(ShmLifecycle, KilledWriterIsReportedDead) {
   ASSERT_TRUE(child.wait_for_child(kHandshakeMs));
   auto reader = ShmPoseReader::open(name());
   ASSERT_TRUE(reader) << reader.error().message;
-  EXPECT_EQ(reader->liveness(kDefaultStaleAfterMs), Liveness::kLive);
+  EXPECT_EQ(reader->liveness(), Liveness::kLive);
   child.kill_child(SIGKILL);
   ASSERT_EQ(child.wait_exit(20'000), 128 + SIGKILL);
-  EXPECT_EQ(reader->liveness(kDefaultStaleAfterMs), Liveness::kWriterDead);
+  EXPECT_EQ(reader->liveness(), Liveness::kWriterDead);
   PoseRecord p;
   EXPECT_EQ(reader->wait_next(5, 20'000, &p), WaitResult::kWriterDead);
 }
@@ -215,15 +215,15 @@ TEST_F(ShmLifecycle, ReaderAcrossWriterRestartSeesRestartedAndReattaches) {
 
   first->release_child();  // clean exit: marks stopped
   ASSERT_EQ(first->wait_exit(20'000), 0);
-  EXPECT_EQ(reader->liveness(kDefaultStaleAfterMs), Liveness::kStopped);
+  EXPECT_EQ(reader->liveness(), Liveness::kStopped);
 
   ForkedChild second(publishing_writer(name(), 2));
   ASSERT_TRUE(second.wait_for_child(kHandshakeMs));
-  EXPECT_EQ(reader->liveness(kDefaultStaleAfterMs), Liveness::kRestarted);
+  EXPECT_EQ(reader->liveness(), Liveness::kRestarted);
   ASSERT_TRUE(reader->reattach());
   EXPECT_NE(reader->writer_info().generation, old_generation);
   EXPECT_EQ(reader->writer_info().pid, second.pid());
-  EXPECT_EQ(reader->liveness(kDefaultStaleAfterMs), Liveness::kLive);
+  EXPECT_EQ(reader->liveness(), Liveness::kLive);
   ASSERT_EQ(reader->read_latest(&p), ReadResult::kOk);
   EXPECT_EQ(p.seq, 2u);
 }

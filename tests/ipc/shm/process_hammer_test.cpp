@@ -45,7 +45,7 @@ TEST(ShmProcessHammer, ReaderProcessNeverSeesTornPoseFromWriterProcess) {
   PoseRecord p;
   while (last < updates) {
     if (reader->read_latest(&p) != ReadResult::kOk) {
-      if (reader->liveness(kDefaultStaleAfterMs) == Liveness::kStopped) break;
+      if (reader->liveness() == Liveness::kStopped) break;
       continue;
     }
     ++reads;

@@ -130,10 +130,11 @@ ForkedChild::Body writer_child(const std::string& name,
   };
 }
 
-void ShmFixture::start(int heartbeat_period_ms) {
+void ShmFixture::start(int heartbeat_period_ms, int stale_after_ms) {
   ShmOptions options;
   options.name = name();
   options.heartbeat_period_ms = heartbeat_period_ms;
+  options.stale_after_ms = stale_after_ms;
   auto writer = ShmPoseWriter::create(options);
   ASSERT_TRUE(writer) << writer.error().message;
   writer_.emplace(std::move(writer.value()));

@@ -90,7 +90,7 @@ ForkedChild::Body writer_child(const std::string& name,
 class ShmFixture : public ::testing::Test {
  protected:
   // Creates the writer and opens a reader; use with ASSERT_NO_FATAL_FAILURE.
-  void start(int heartbeat_period_ms = 50);
+  void start(int heartbeat_period_ms = 50, int stale_after_ms = ShmOptions{}.stale_after_ms);
   const std::string& name() const { return name_.str(); }
   ShmPoseWriter& writer() { return *writer_; }
   ShmPoseReader& reader() { return *reader_; }

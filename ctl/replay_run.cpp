@@ -1,0 +1,122 @@
+#include "ctl/replay_run.h"
+
+#include <unistd.h>
+
+#include <algorithm>
+#include <cstdio>
+#include <utility>
+#include <vector>
+
+#include "config/service_config.h"
+
+namespace ceilpose::ctl {
+namespace {
+
+// Frames refused for wrong heights show only "refusal":"wrong_heights"; say
+// once, after the run, what distance the markers imply instead.
+class HeightsCheck final : public PoseSink {
+ public:
+  explicit HeightsCheck(size_t frames) { depth_scales_.reserve(frames); }
+  void consume(const Localization& loc) override {
+    if (loc.measured.depth_scale > 0.0) depth_scales_.push_back(loc.measured.depth_scale);
+    if (loc.refusal == Refusal::kWrongHeights) ++refused_;
+  }
+  void warn(const char* command, const PipelineConfig& config) {
+    if (refused_ == 0 || depth_scales_.empty()) return;
+    const auto mid = depth_scales_.begin() + static_cast<ptrdiff_t>(depth_scales_.size() / 2);
+    std::nth_element(depth_scales_.begin(), mid, depth_scales_.end());
+    const double depth_m = config.layout.height_m - config.mount.lens_height_m;
+    std::fprintf(stderr,
+                 "ceilposectl %s: warning: the markers' spacing puts the ceiling %.3f m above the "
+                 "lens (median of %zu frames), the configuration says %.3f m (ceiling.height_m "
+                 "%.4f - mount.lens_height_m %.4f); %zu frames more than %.0f %% off got no "
+                 "pose: check the heights (--config)\n",
+                 command, *mid * depth_m, depth_scales_.size(), depth_m, config.layout.height_m,
+                 config.mount.lens_height_m, refused_,
+                 100.0 * config.positioning.max_depth_scale_error);
+  }
+
+ private:
+  std::vector<double> depth_scales_;
+  size_t refused_ = 0;
+};
+
+}  // namespace
+
+void add_replay_options(CLI::App* cmd, ReplayArgs* args) {
+  cmd->add_option("--replay", args->dir, "Recording directory (SPEC §4)")->required();
+  cmd->add_option("--config", args->config_file,
+                  "Configuration file overriding SPEC's defaults (the camera intrinsics always "
+                  "come from the recording's recording.yaml)");
+  cmd->add_flag("--filter", args->filter,
+                "Apply the daemon's temporal filter (default: every frame solved on its own)");
+  cmd->add_option("--mode", args->mode_text, "Positioning mode: auto | axes | barycentric | lsq")
+      ->check(CLI::IsMember(positioning_mode_names()));
+  cmd->add_option("--decode-threads", args->decode_threads,
+                  "Threads decoding frames ahead of localization (default: CPUs, at most 4); "
+                  "frames are still localized one at a time, in order")
+      ->check(CLI::Range(1, 64))
+      ->capture_default_str();
+}
+
+int prepare_replay(const ReplayArgs& args, const char* command, ReplaySetup* setup) {
+  PositioningMode mode = PositioningMode::kAuto;
+  if (!args.config_file.empty()) {
+    auto loaded = load_config_file(args.config_file);
+    if (!loaded.ok()) {
+      std::fprintf(stderr, "ceilposectl %s: %s\n", command, loaded.error().message.c_str());
+      return kExitBadInput;
+    }
+    setup->config = loaded->pipeline;
+    mode = loaded->positioning_mode;
+  }
+  if (!args.mode_text.empty() && !parse_positioning_mode(args.mode_text, &mode)) {
+    std::fprintf(stderr, "ceilposectl %s: --mode %s: expected one of %s\n", command,
+                 args.mode_text.c_str(), positioning_mode_list().c_str());
+    return kExitUsage;
+  }
+  setup->localizer = LocalizerOptions{mode, args.filter};
+  auto reader = RecordingReader::open(args.dir);
+  if (!reader.ok()) {
+    std::fprintf(stderr, "ceilposectl %s: %s\n", command, reader.error().message.c_str());
+    return kExitBadInput;
+  }
+  setup->config.intrinsics = reader->camera().intrinsics;
+  setup->reader.emplace(std::move(reader.value()));
+  return kExitOk;
+}
+
+int run_replay(const ReplayArgs& args, const char* command, const ReplaySetup& setup,
+               std::span<PoseSink* const> sinks) {
+  const RecordingReader& reader = *setup.reader;
+  Localizer localizer(setup.config, setup.localizer);
+  FramePrefetcher frames(reader, args.decode_threads);
+  const size_t total = reader.rows().size();
+  HeightsCheck heights(total);
+  const bool tty = ::isatty(STDERR_FILENO) == 1;
+  for (size_t i = 0; i < total; ++i) {
+    auto loaded = frames.next();
+    if (!loaded.ok()) {
+      if (tty) std::fputc('\n', stderr);
+      std::fprintf(stderr, "ceilposectl %s: %s\n", command, loaded.error().message.c_str());
+      return kExitBadInput;
+    }
+    const RecordingRow& row = reader.rows()[i];
+    FrameInfo info;
+    info.timestamp_ns = row.timestamp_ns;
+    info.index = row.index;
+    info.has_ground_truth = row.has_ground_truth;
+    info.ground_truth = row.ground_truth;
+    const Localization& loc = localizer.localize((*loaded)->view(), info);
+    heights.consume(loc);
+    for (PoseSink* sink : sinks) sink->consume(loc);
+    if (tty && (i % 25 == 0 || i + 1 == total)) {
+      std::fprintf(stderr, "\r%s: frame %zu/%zu", command, i + 1, total);
+      if (i + 1 == total) std::fputc('\n', stderr);
+    }
+  }
+  heights.warn(command, setup.config);
+  return kExitOk;
+}
+
+}  // namespace ceilpose::ctl

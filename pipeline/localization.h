@@ -1,0 +1,41 @@
+#pragma once
+// What localizing one frame gives every consumer (shared memory, DDS, JSON
+// Lines, accuracy scoring): the frame on its own, the pose to publish, the
+// fix state and, when there is no pose, why.
+#include <array>
+#include <cstdint>
+
+#include "core/fix_state.h"
+#include "core/pose.h"
+#include "core/refusal.h"
+#include "pipeline/pipeline.h"
+#include "pipeline/pose_estimate.h"
+
+namespace ceilpose {
+
+// Where a frame came from, as far as the consumers care.
+struct FrameInfo {
+  int64_t timestamp_ns = 0;  // the frame's time (capture, or the recording's)
+  int64_t index = -1;        // the recording's frame index, else -1
+  bool has_ground_truth = false;
+  Pose2D ground_truth;
+};
+
+struct Localization {
+  FrameInfo frame;
+  PoseEstimate measured;   // this frame solved on its own
+  PoseEstimate published;  // what to publish: the filter's output, or `measured` unfiltered
+  bool filtered = false;   // `published` came from the temporal filter
+  FixState fix = FixState::kNone;
+  // Why this frame gave no measurement (kNone when it did; kFilterRejected
+  // when it did but the filter refused it). published.refusal says why the
+  // published pose is invalid: the same, or kNone while coasting.
+  Refusal refusal = Refusal::kNone;
+  int markers_decoded = 0;                      // markers the pipeline decoded
+  std::array<int64_t, kStageCount> stage_ns{};  // duration of each pipeline stage
+  int64_t localize_ns = 0;                      // whole localization, filter included
+
+  bool coasting() const { return published.valid && !measured.valid; }
+};
+
+}  // namespace ceilpose

@@ -1,0 +1,54 @@
+#include "pipeline/localizer.h"
+
+#include "core/clock.h"
+
+namespace ceilpose {
+
+Localizer::Localizer(const PipelineConfig& config, LocalizerOptions options)
+    : pipeline_(config),
+      options_(options),
+      filter_(config.filter),
+      result_(std::make_unique<FrameResult>()) {}
+
+void Localizer::reconfigure(const PipelineConfig& config, LocalizerOptions options,
+                            bool reset_filter) {
+  pipeline_.set_config(config);
+  options_ = options;
+  if (reset_filter) {
+    filter_ = TemporalFilter(config.filter);
+    had_fix_ = false;
+  }
+}
+
+const Localization& Localizer::localize(const ImageView& image, const FrameInfo& frame) {
+  const int64_t start_ns = monotonic_ns();
+  // 1. The frame on its own.
+  pipeline_.process(image, options_.mode, result_.get());
+  out_.frame = frame;
+  out_.measured = result_->estimate;
+  out_.markers_decoded = result_->marker_count;
+  out_.stage_ns = result_->stage_ns;
+
+  // 2. Over time (the frame's own time, so processing jitter does not enter).
+  out_.filtered = options_.filter;
+  out_.published =
+      options_.filter ? filter_.update(out_.measured, frame.timestamp_ns) : out_.measured;
+  if (!out_.published.valid) {
+    out_.published.refusal = out_.measured.valid ? Refusal::kFilterRejected : out_.measured.refusal;
+  }
+  out_.refusal = out_.measured.valid ? out_.published.refusal : out_.measured.refusal;
+
+  // 3. Fix state.
+  if (out_.measured.valid && out_.published.valid) {
+    had_fix_ = true;
+    out_.fix = FixState::kOk;
+  } else {
+    out_.fix =
+        out_.published.valid ? FixState::kCoasting : (had_fix_ ? FixState::kLost : FixState::kNone);
+  }
+  refusals_.count(out_.refusal);
+  out_.localize_ns = monotonic_ns() - start_ns;
+  return out_;
+}
+
+}  // namespace ceilpose

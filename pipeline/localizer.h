@@ -1,0 +1,56 @@
+#pragma once
+// The one path of a frame: pipeline (detection and positioning), temporal
+// filter and fix state, for the daemon, `locate`/`evaluate`, the accuracy
+// tests and the benchmarks alike. Counts every frame's refusal.
+//
+// Not thread-safe: one instance, called in frame order from one thread;
+// refusals() may be read from any thread. localize() allocates nothing,
+// throws nothing and logs nothing.
+#include <memory>
+
+#include "core/refusal.h"
+#include "pipeline/localization.h"
+#include "pipeline/pipeline.h"
+#include "pipeline/pipeline_config.h"
+#include "pipeline/temporal_filter.h"
+
+namespace ceilpose {
+
+struct LocalizerOptions {
+  PositioningMode mode = PositioningMode::kAuto;
+  // Apply the temporal filter (the daemon's default; `locate` with --filter).
+  bool filter = true;
+};
+
+class Localizer {
+ public:
+  // Throws std::invalid_argument (from Pipeline) on a non-positive image size.
+  Localizer(const PipelineConfig& config, LocalizerOptions options);
+
+  // Localizes one frame taken at frame.timestamp_ns (monotonic order). The
+  // result stays valid until the next call.
+  const Localization& localize(const ImageView& image, const FrameInfo& frame);
+
+  // Between frames (SIGHUP): new tuning, mode and filter switch; the filter's
+  // state is kept unless `reset_filter`.
+  void reconfigure(const PipelineConfig& config, LocalizerOptions options, bool reset_filter);
+
+  const PipelineConfig& config() const { return pipeline_.config(); }
+  const LocalizerOptions& options() const { return options_; }
+  const RefusalHistogram& refusals() const { return refusals_; }
+  const FilterStats& filter_stats() const { return filter_.stats(); }
+  // The last frame's detection in detail (markers, rejects), for diagnostics.
+  const FrameResult& last_frame() const { return *result_; }
+  const Pipeline& pipeline() const { return pipeline_; }
+
+ private:
+  Pipeline pipeline_;
+  LocalizerOptions options_;
+  TemporalFilter filter_;
+  std::unique_ptr<FrameResult> result_;  // ~50 kB: on the heap, allocated once
+  Localization out_;
+  bool had_fix_ = false;
+  RefusalHistogram refusals_;
+};
+
+}  // namespace ceilpose
