@@ -2,10 +2,8 @@
 
 #include <spdlog/spdlog.h>
 
-#include "capture/v4l2_source.h"
-#ifdef CEILPOSE_CAPTURE_HAVE_SIM
 #include "capture/synthetic_source.h"
-#endif
+#include "capture/v4l2_source.h"
 #ifdef CEILPOSE_CAPTURE_HAVE_RECORDING
 #include "capture/replay_source.h"
 #endif
@@ -98,14 +96,13 @@ Error bad_spec(std::string_view spec, const std::string& why) {
 }  // namespace
 
 Result<std::unique_ptr<FrameSource>> make_frame_source(std::string_view spec,
-                                                       const SourceOptions& options) {
+                                                       const SourceOptions& options,
+                                                       std::shared_ptr<FrameGenerator> generator) {
   auto after = [&](std::string_view prefix) { return std::string(spec.substr(prefix.size())); };
-  if (spec == "synthetic") {
-#ifdef CEILPOSE_CAPTURE_HAVE_SIM
-    return std::unique_ptr<FrameSource>(std::make_unique<SyntheticSource>(options));
-#else
-    return bad_spec(spec, "this build has no simulator (ceilpose_sim)");
-#endif
+  if (spec == kSyntheticSourceSpec) {
+    if (!generator) return bad_spec(spec, "the synthetic camera needs a frame generator");
+    return std::unique_ptr<FrameSource>(
+        std::make_unique<SyntheticSource>(options, std::move(generator)));
   }
   if (spec.starts_with("replay:")) {
     const std::string dir = after("replay:");

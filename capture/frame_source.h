@@ -29,9 +29,8 @@
 
 #include "capture/frame.h"
 #include "core/camera_model.h"
-#include "core/ceiling_layout.h"
+#include "core/frame_generator.h"
 #include "core/result.h"
-#include "sim/effects.h"
 
 namespace ceilpose::capture {
 
@@ -73,14 +72,6 @@ struct SourceOptions {
   double replay_speed = 1.0;
   bool replay_as_fast_as_possible = false;
   bool replay_loop = false;
-
-  // Synthetic: the simulated ceiling and camera, and the image effects.
-  CameraIntrinsics intrinsics;  // also the image size of the synthetic camera
-  CeilingLayout layout;
-  CameraMount mount;
-  sim::Effects effects;
-  uint64_t seed = 1;
-  double trajectory_start_s = 0.0;  // time along sim::trajectory_pose of the first frame
 };
 
 class FrameSource {
@@ -134,10 +125,15 @@ class FrameSource {
   bool warned_next_state_ = false;
 };
 
+// The SPEC §7 source spec of the synthetic camera.
+inline constexpr std::string_view kSyntheticSourceSpec = "synthetic";
+
 // SPEC §7 source spec: synthetic | replay:DIR | v4l2:/dev/videoN | libcamera[:ID].
-// The returned source is Closed; an unknown spec or a backend not built in is
-// an error naming the spec.
-Result<std::unique_ptr<FrameSource>> make_frame_source(std::string_view spec,
-                                                       const SourceOptions& options);
+// The returned source is Closed; an unknown spec, a backend not built in, or
+// "synthetic" without a `generator` (what renders its images) is an error
+// naming the spec.
+Result<std::unique_ptr<FrameSource>> make_frame_source(
+    std::string_view spec, const SourceOptions& options,
+    std::shared_ptr<FrameGenerator> generator = nullptr);
 
 }  // namespace ceilpose::capture

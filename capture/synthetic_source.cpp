@@ -6,19 +6,19 @@
 
 #include "capture/wait.h"
 #include "core/clock.h"
-#include "sim/trajectory.h"
 
 namespace ceilpose::capture {
 
-SyntheticSource::SyntheticSource(SourceOptions options) : options_(std::move(options)) {}
+SyntheticSource::SyntheticSource(SourceOptions options, std::shared_ptr<FrameGenerator> generator)
+    : options_(std::move(options)), generator_(std::move(generator)) {}
 
 SyntheticSource::~SyntheticSource() = default;
 
 std::string SyntheticSource::describe() const {
+  const CameraIntrinsics& k = generator_->intrinsics();
   char text[160];
-  std::snprintf(text, sizeof text, "synthetic %dx%d %.1f fps, seed %llu", options_.intrinsics.width,
-                options_.intrinsics.height, options_.fps,
-                static_cast<unsigned long long>(options_.seed));
+  std::snprintf(text, sizeof text, "synthetic %dx%d %.1f fps, %s", k.width, k.height, options_.fps,
+                generator_->describe().c_str());
   return text;
 }
 
@@ -27,12 +27,11 @@ Result<void> SyntheticSource::do_open() {
     return make_error("synthetic: frame rate must be in (0, 10000] fps, got " +
                       std::to_string(options_.fps));
   }
-  const auto& k = options_.intrinsics;
+  const CameraIntrinsics& k = generator_->intrinsics();
   if (k.width <= 0 || k.height <= 0) {
     return make_error("synthetic: camera size must be positive, got " + std::to_string(k.width) +
                       "x" + std::to_string(k.height));
   }
-  renderer_.emplace(sim::SceneOptions{options_.layout, k, options_.seed});
   pool_.resize(std::max(2, options_.buffer_count), k.width, k.height, PixelFormat::kRgb24);
   period_ns_ = static_cast<int64_t>(std::llround(1e9 / options_.fps));
   return {};
@@ -68,10 +67,8 @@ NextStatus SyntheticSource::do_next(Frame* out, int timeout_ms) {
     ++stats_.drops;  // every slot held downstream, like a camera with no free buffer
     return NextStatus::kTimeout;
   }
-  const double t_s = options_.trajectory_start_s + static_cast<double>(due_ns - start_ns_) * 1e-9;
-  const Pose2D pose = sim::trajectory_pose(options_.layout, t_s);
-  renderer_->render(pose, options_.mount, options_.effects, options_.seed * 1'000'003 + tick,
-                    image);
+  Pose2D pose;
+  generator_->generate(due_ns - start_ns_, tick, image, &pose);
   Frame f;
   f.image = image->view();
   f.capture_ns = due_ns;

@@ -1,36 +1,34 @@
 #pragma once
-// The simulator as a live camera (synthetic): renders the SPEC ceiling as seen
-// from a robot following sim::trajectory_pose, at options.fps, paced on
-// CLOCK_MONOTONIC with absolute sleeps so the rate does not drift. Each frame
-// carries its ground-truth pose. Image size and lens come from
-// options.intrinsics; options.effects degrade the image.
-//
-// This is capture's one dependency on sim/: it calls sim::Renderer with a pose
-// and knows nothing of markers.
+// A synthetic live camera: asks its FrameGenerator (in ceilposed, the
+// simulator) for each exposure at options.fps, paced on CLOCK_MONOTONIC with
+// absolute sleeps so the rate does not drift. Each frame carries the
+// generator's ground-truth pose; image size and lens are the generator's.
+// capture knows frames only: nothing here knows what the image shows.
 //
 // If rendering falls behind the frame rate, the ticks that passed are counted
 // as drops (as a camera would lose them) and the next frame is the current one.
 //
 // Threads: see FrameSource; one thread (the capture thread) only.
+#include <memory>
 #include <optional>
 
 #include "capture/frame_pool.h"
 #include "capture/frame_source.h"
-#include "sim/renderer.h"
+#include "core/frame_generator.h"
 
 namespace ceilpose::capture {
 
 class SyntheticSource final : public FrameSource {
  public:
   // Stores the configuration; cannot fail.
-  explicit SyntheticSource(SourceOptions options);
+  SyntheticSource(SourceOptions options, std::shared_ptr<FrameGenerator> generator);
   ~SyntheticSource() override;
 
   std::string describe() const override;
   SourceStats stats() const override { return stats_; }
   int buffers() const override { return pool_.size(); }
   bool camera_intrinsics(CameraIntrinsics* out) const override {
-    *out = options_.intrinsics;
+    *out = generator_->intrinsics();
     return true;
   }
 
@@ -43,7 +41,7 @@ class SyntheticSource final : public FrameSource {
 
  private:
   const SourceOptions options_;
-  std::optional<sim::Renderer> renderer_;
+  const std::shared_ptr<FrameGenerator> generator_;
   FramePool pool_;
   int64_t period_ns_ = 0;
   int64_t start_ns_ = 0;

@@ -13,6 +13,7 @@
 #include "core/clock.h"
 #include "ctl/command_registry.h"
 #include "recording/recording_writer.h"
+#include "sim/trajectory_camera.h"
 
 namespace ceilpose::ctl {
 namespace {
@@ -58,9 +59,14 @@ int run_record(const RecordArgs& a) {
   options.width = a.width;
   options.height = a.height;
   options.fps = a.fps;
-  options.seed = a.seed;
   options.replay_as_fast_as_possible = !a.realtime_replay;
-  auto made = capture::make_frame_source(a.source, options);
+  std::shared_ptr<FrameGenerator> generator;
+  if (a.source == capture::kSyntheticSourceSpec) {
+    sim::TrajectoryCameraOptions camera;
+    camera.scene.seed = a.seed;
+    generator = std::make_shared<sim::TrajectoryCamera>(camera);
+  }
+  auto made = capture::make_frame_source(a.source, options, std::move(generator));
   if (!made) return fail(kExitUsage, made.error().message);
   capture::FrameSource& source = **made;
   if (auto r = source.open(); !r)

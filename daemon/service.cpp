@@ -24,6 +24,7 @@
 #include "daemon/systemd_notifier.h"
 #include "daemon/watchdog_gate.h"
 #include "ipc/shm/shm_pose_writer.h"
+#include "sim/trajectory_camera.h"
 #ifdef CEILPOSE_DAEMON_HAVE_DDS
 #include "daemon/dds_pose_sink.h"
 #include "ipc/dds/dds_options.h"
@@ -74,11 +75,17 @@ capture::SourceOptions source_options(const ServiceConfig& c) {
   o.replay_as_fast_as_possible = c.capture.replay_speed == 0.0;
   o.replay_speed = o.replay_as_fast_as_possible ? 1.0 : c.capture.replay_speed;
   o.replay_loop = c.capture.replay_loop;
-  o.intrinsics = c.pipeline.intrinsics;
-  o.layout = c.pipeline.layout;
-  o.mount = c.pipeline.mount;
-  o.seed = c.capture.synthetic_seed;
   return o;
+}
+
+// The synthetic camera shows the configured ceiling through the configured
+// camera and mount; other sources need no generator.
+std::shared_ptr<FrameGenerator> frame_generator(const ServiceConfig& c) {
+  if (c.capture.source != capture::kSyntheticSourceSpec) return nullptr;
+  sim::TrajectoryCameraOptions o;
+  o.scene = sim::SceneOptions{c.pipeline.layout, c.pipeline.intrinsics, c.capture.synthetic_seed};
+  o.mount = c.pipeline.mount;
+  return std::make_shared<sim::TrajectoryCamera>(o);
 }
 
 // Test hook, documented in docs/service.md: only tests set it.
@@ -179,7 +186,8 @@ class Service {
 int Service::start() {
   start_ns_ = monotonic_ns();
   // 1. Capture: opens the source on its own thread.
-  auto source = capture::make_frame_source(config_.capture.source, source_options(config_));
+  auto source = capture::make_frame_source(config_.capture.source, source_options(config_),
+                                           frame_generator(config_));
   if (!source) {
     spdlog::error("frame source: {}", source.error().message);
     return kExitSourceFailure;

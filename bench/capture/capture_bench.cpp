@@ -11,11 +11,10 @@
 #include "capture/latency_histogram.h"
 #include "capture/pixel_convert.h"
 #include "capture/spsc_ring.h"
-#include "core/clock.h"
-#include "tests/capture/counting_source.h"
-#ifdef CEILPOSE_CAPTURE_HAVE_SIM
 #include "capture/synthetic_source.h"
-#endif
+#include "core/clock.h"
+#include "sim/trajectory_camera.h"
+#include "tests/capture/counting_source.h"
 
 namespace ceilpose::capture {
 namespace {
@@ -93,13 +92,13 @@ void BM_YuyvToRgb640x480(benchmark::State& state) {
 }
 BENCHMARK(BM_YuyvToRgb640x480);
 
-#ifdef CEILPOSE_CAPTURE_HAVE_SIM
 // One synthetic frame: trajectory pose plus a 640x480 render (the rate is
 // set so high that next() never sleeps).
 void BM_SyntheticFrame640x480(benchmark::State& state) {
   SourceOptions o;
   o.fps = 10000.0;
-  SyntheticSource source(o);
+  SyntheticSource source(o,
+                         std::make_shared<sim::TrajectoryCamera>(sim::TrajectoryCameraOptions{}));
   if (!source.open() || !source.start()) {
     state.SkipWithError("synthetic source failed to start");
     return;
@@ -112,7 +111,6 @@ void BM_SyntheticFrame640x480(benchmark::State& state) {
   }
 }
 BENCHMARK(BM_SyntheticFrame640x480)->Unit(benchmark::kMillisecond)->UseRealTime();
-#endif
 
 }  // namespace
 }  // namespace ceilpose::capture

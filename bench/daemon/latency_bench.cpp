@@ -33,6 +33,7 @@
 #include "recording/recording_writer.h"
 #include "sim/renderer.h"
 #include "sim/scenarios.h"
+#include "sim/trajectory_camera.h"
 
 namespace ceilpose {
 namespace {
@@ -103,9 +104,9 @@ void BM_FrameToPose(benchmark::State& state, bool replay) {
   so.width = config.capture.width_px;
   so.height = config.capture.height_px;
   so.fps = fps;
-  so.intrinsics = config.pipeline.intrinsics;
-  so.layout = config.pipeline.layout;
-  so.mount = config.pipeline.mount;
+  sim::TrajectoryCameraOptions camera;
+  camera.scene = sim::SceneOptions{config.pipeline.layout, config.pipeline.intrinsics, 1};
+  camera.mount = config.pipeline.mount;
   if (replay) {
     spec = "replay:" + replay_dir();
     so.replay_speed = fps / 30.0;  // the recording is 30 fps
@@ -113,7 +114,8 @@ void BM_FrameToPose(benchmark::State& state, bool replay) {
   }
 
   for (auto _ : state) {
-    auto source = capture::make_frame_source(spec, so);
+    auto source = capture::make_frame_source(
+        spec, so, replay ? nullptr : std::make_shared<sim::TrajectoryCamera>(camera));
     if (!source) {
       state.SkipWithError(source.error().message.c_str());
       return;

@@ -3,6 +3,8 @@
 
 #include <gtest/gtest.h>
 
+#include "sim/trajectory_camera.h"
+
 namespace ceilpose::capture {
 namespace {
 
@@ -34,14 +36,14 @@ TEST(MakeFrameSource, AMissingV4l2DeviceFailsInOpenNamingIt) {
       << opened.error().message;
 }
 
-#ifdef CEILPOSE_CAPTURE_HAVE_SIM
-TEST(MakeFrameSource, SyntheticSpecMakesALiveSyntheticCamera) {
-  auto r = make_frame_source("synthetic", SourceOptions{});
+TEST(MakeFrameSource, SyntheticSpecMakesALiveSyntheticCameraOverItsGenerator) {
+  auto r =
+      make_frame_source("synthetic", SourceOptions{},
+                        std::make_shared<sim::TrajectoryCamera>(sim::TrajectoryCameraOptions{}));
   ASSERT_TRUE(r) << r.error().message;
-  EXPECT_NE((*r)->describe().find("synthetic"), std::string::npos);
+  EXPECT_NE((*r)->describe().find("synthetic 640x480"), std::string::npos) << (*r)->describe();
   EXPECT_TRUE((*r)->live());
 }
-#endif
 
 }  // namespace
 }  // namespace ceilpose::capture

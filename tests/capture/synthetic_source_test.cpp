@@ -1,29 +1,87 @@
-// SyntheticSource: the simulator as a live camera.
+// SyntheticSource: a live camera over a FrameGenerator, here the simulator
+// (sim::TrajectoryCamera, as ceilposed wires it).
 #include "capture/synthetic_source.h"
 
 #include <gtest/gtest.h>
 
 #include "sim/trajectory.h"
+#include "sim/trajectory_camera.h"
 
 namespace ceilpose::capture {
 namespace {
 
 // A small camera keeps rendering well under the frame period on a loaded machine.
-SourceOptions small_camera(double fps) {
-  SourceOptions o;
-  o.fps = fps;
-  o.intrinsics.width = 160;
-  o.intrinsics.height = 120;
-  o.intrinsics.fx = o.intrinsics.fy = 132.5;
-  o.intrinsics.cx = 79.5;
-  o.intrinsics.cy = 59.5;
+sim::TrajectoryCameraOptions small_scene() {
+  sim::TrajectoryCameraOptions o;
+  o.scene.intrinsics.width = 160;
+  o.scene.intrinsics.height = 120;
+  o.scene.intrinsics.fx = o.scene.intrinsics.fy = 132.5;
+  o.scene.intrinsics.cx = 79.5;
+  o.scene.intrinsics.cy = 59.5;
   o.trajectory_start_s = 3.0;
   return o;
 }
 
+SourceOptions at_rate(double fps) {
+  SourceOptions o;
+  o.fps = fps;
+  return o;
+}
+
+std::shared_ptr<FrameGenerator> small_camera() {
+  return std::make_shared<sim::TrajectoryCamera>(small_scene());
+}
+
+// Proves capture needs nothing of the simulator: a generator that only
+// stamps what it was asked.
+struct StampingGenerator final : FrameGenerator {
+  const CameraIntrinsics& intrinsics() const override { return k; }
+  void generate(int64_t elapsed_ns, uint64_t tick, Image* out, Pose2D* truth) override {
+    out->data()[0] = static_cast<uint8_t>(tick);
+    *truth = Pose2D{static_cast<double>(elapsed_ns) * 1e-9, static_cast<double>(tick), 0.0};
+  }
+  std::string describe() const override { return "stamps"; }
+  CameraIntrinsics k = [] {
+    CameraIntrinsics c;
+    c.width = 8;
+    c.height = 6;
+    return c;
+  }();
+};
+
+TEST(SyntheticSource, AnyGeneratorFeedsItAndItsTicksAndTimesArriveWithTheFrames) {
+  auto generator = std::make_shared<StampingGenerator>();
+  SyntheticSource source(at_rate(200.0), generator);
+  ASSERT_TRUE(source.open());
+  ASSERT_TRUE(source.start());
+  EXPECT_NE(source.describe().find("8x6 200.0 fps, stamps"), std::string::npos)
+      << source.describe();
+  Frame first;
+  for (int i = 0; i < 3; ++i) {
+    Frame f;
+    int calls = 0;
+    NextStatus s;
+    while ((s = source.next(&f, 100)) == NextStatus::kTimeout) ASSERT_LT(++calls, 100);
+    ASSERT_EQ(s, NextStatus::kFrame);
+    if (i == 0) first = f;
+    EXPECT_EQ(f.image.width, 8);
+    EXPECT_EQ(f.image.data[0], static_cast<uint8_t>(f.ground_truth.y_m));
+    EXPECT_NEAR(f.ground_truth.x_m - first.ground_truth.x_m,
+                (f.capture_ns - first.capture_ns) * 1e-9, 1e-9);
+    source.release(f);
+  }
+}
+
+TEST(MakeFrameSource, SyntheticWithoutAGeneratorIsAnErrorNamingTheSpec) {
+  auto r = make_frame_source("synthetic", SourceOptions{});
+  ASSERT_FALSE(r);
+  EXPECT_NE(r.error().message.find("synthetic"), std::string::npos) << r.error().message;
+  EXPECT_NE(r.error().message.find("generator"), std::string::npos) << r.error().message;
+}
+
 TEST(SyntheticSource, DeliversRenderedFramesWithTheirTrajectoryGroundTruth) {
-  SourceOptions o = small_camera(50.0);
-  SyntheticSource source(o);
+  const sim::TrajectoryCameraOptions o = small_scene();
+  SyntheticSource source(at_rate(50.0), std::make_shared<sim::TrajectoryCamera>(o));
   ASSERT_TRUE(source.open());
   ASSERT_TRUE(source.start());
   Frame first;
@@ -39,7 +97,7 @@ TEST(SyntheticSource, DeliversRenderedFramesWithTheirTrajectoryGroundTruth) {
     EXPECT_EQ(f.image.height, 120);
     EXPECT_EQ(f.image.format, PixelFormat::kRgb24);
     const double t_s = o.trajectory_start_s + (f.capture_ns - first.capture_ns) * 1e-9;
-    const Pose2D expected = sim::trajectory_pose(o.layout, t_s);
+    const Pose2D expected = sim::trajectory_pose(o.scene.layout, t_s);
     EXPECT_NEAR(f.ground_truth.x_m, expected.x_m, 1e-9);
     EXPECT_NEAR(f.ground_truth.y_m, expected.y_m, 1e-9);
     EXPECT_NEAR(f.ground_truth.yaw_rad, expected.yaw_rad, 1e-9);
@@ -49,7 +107,7 @@ TEST(SyntheticSource, DeliversRenderedFramesWithTheirTrajectoryGroundTruth) {
 }
 
 TEST(SyntheticSource, FramesFollowTheConfiguredRateOnTheMonotonicClock) {
-  SyntheticSource source(small_camera(100.0));
+  SyntheticSource source(at_rate(100.0), small_camera());
   ASSERT_TRUE(source.open());
   ASSERT_TRUE(source.start());
   int64_t previous_ns = 0;
@@ -70,7 +128,7 @@ TEST(SyntheticSource, FramesFollowTheConfiguredRateOnTheMonotonicClock) {
 }
 
 TEST(SyntheticSource, TheImageShowsTheCeilingNotABlank) {
-  SyntheticSource source(small_camera(50.0));
+  SyntheticSource source(at_rate(50.0), small_camera());
   ASSERT_TRUE(source.open());
   ASSERT_TRUE(source.start());
   Frame f;
@@ -88,7 +146,7 @@ TEST(SyntheticSource, TheImageShowsTheCeilingNotABlank) {
 }
 
 TEST(SyntheticSource, ANonPositiveFrameRateFailsInOpen) {
-  SyntheticSource source(small_camera(0.0));
+  SyntheticSource source(at_rate(0.0), small_camera());
   auto r = source.open();
   ASSERT_FALSE(r);
   EXPECT_NE(r.error().message.find("frame rate"), std::string::npos) << r.error().message;

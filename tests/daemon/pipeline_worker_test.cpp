@@ -15,6 +15,7 @@
 #include "daemon/shm_pose_sink.h"
 #include "ipc/shm/shm_pose_reader.h"
 #include "ipc/shm/shm_pose_writer.h"
+#include "sim/trajectory_camera.h"
 
 namespace ceilpose::daemon {
 namespace {
@@ -22,11 +23,12 @@ namespace {
 struct Rig {
   Rig() {
     capture::SourceOptions so;
-    so.intrinsics = config.pipeline.intrinsics;
-    so.layout = config.pipeline.layout;
-    so.mount = config.pipeline.mount;
     so.fps = 30.0;
-    auto source = capture::make_frame_source("synthetic", so);
+    sim::TrajectoryCameraOptions camera;
+    camera.scene = sim::SceneOptions{config.pipeline.layout, config.pipeline.intrinsics, 1};
+    camera.mount = config.pipeline.mount;
+    auto source = capture::make_frame_source("synthetic", so,
+                                             std::make_shared<sim::TrajectoryCamera>(camera));
     if (!source) throw std::runtime_error(source.error().message);
     capture::CaptureThreadOptions copts;
     copts.realtime_priority = 0;  // tests run unprivileged too
