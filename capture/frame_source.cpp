@@ -2,6 +2,7 @@
 
 #include <spdlog/spdlog.h>
 
+#include "capture/source_spec.h"
 #include "capture/synthetic_source.h"
 #include "capture/v4l2_source.h"
 #ifdef CEILPOSE_CAPTURE_HAVE_RECORDING
@@ -86,11 +87,9 @@ void FrameSource::stop() {
 
 namespace {
 
-constexpr const char* kSpecForms = "synthetic | replay:DIR | v4l2:/dev/videoN | libcamera[:ID]";
-
 Error bad_spec(std::string_view spec, const std::string& why) {
-  return make_error("Source '" + std::string(spec) + "': " + why + " (expected " + kSpecForms +
-                    ")");
+  return make_error("Source '" + std::string(spec) + "': " + why + " (expected " +
+                    std::string(kSourceSpecForms) + ")");
 }
 
 }  // namespace
@@ -98,32 +97,29 @@ Error bad_spec(std::string_view spec, const std::string& why) {
 Result<std::unique_ptr<FrameSource>> make_frame_source(std::string_view spec,
                                                        const SourceOptions& options,
                                                        std::shared_ptr<FrameGenerator> generator) {
-  auto after = [&](std::string_view prefix) { return std::string(spec.substr(prefix.size())); };
-  if (spec == kSyntheticSourceSpec) {
-    if (!generator) return bad_spec(spec, "the synthetic camera needs a frame generator");
-    return std::unique_ptr<FrameSource>(
-        std::make_unique<SyntheticSource>(options, std::move(generator)));
-  }
-  if (spec.starts_with("replay:")) {
-    const std::string dir = after("replay:");
-    if (dir.empty()) return bad_spec(spec, "replay needs a recording directory");
+  std::string why;
+  const std::optional<SourceSpec> parsed = parse_source_spec(spec, &why);
+  if (!parsed) return bad_spec(spec, why);
+  switch (parsed->kind) {
+    case SourceKind::kSynthetic:
+      if (!generator) return bad_spec(spec, "the synthetic camera needs a frame generator");
+      return std::unique_ptr<FrameSource>(
+          std::make_unique<SyntheticSource>(options, std::move(generator)));
+    case SourceKind::kReplay:
 #ifdef CEILPOSE_CAPTURE_HAVE_RECORDING
-    return std::unique_ptr<FrameSource>(std::make_unique<ReplaySource>(dir, options));
+      return std::unique_ptr<FrameSource>(
+          std::make_unique<ReplaySource>(parsed->argument, options));
 #else
-    return bad_spec(spec, "this build has no recording reader (ceilpose_recording)");
+      return bad_spec(spec, "this build has no recording reader (ceilpose_recording)");
 #endif
-  }
-  if (spec.starts_with("v4l2:")) {
-    const std::string path = after("v4l2:");
-    if (path.empty()) return bad_spec(spec, "v4l2 needs a device path");
-    return std::unique_ptr<FrameSource>(std::make_unique<V4l2Source>(path, options));
-  }
-  if (spec == "libcamera" || spec.starts_with("libcamera:")) {
-    const std::string id = spec == "libcamera" ? std::string() : after("libcamera:");
+    case SourceKind::kV4l2:
+      return std::unique_ptr<FrameSource>(std::make_unique<V4l2Source>(parsed->argument, options));
+    case SourceKind::kLibcamera:
 #ifdef CEILPOSE_CAPTURE_HAVE_LIBCAMERA
-    return std::unique_ptr<FrameSource>(std::make_unique<LibcameraSource>(id, options));
+      return std::unique_ptr<FrameSource>(
+          std::make_unique<LibcameraSource>(parsed->argument, options));
 #else
-    return bad_spec(spec, "this build has no libcamera support (libcamera-dev not found)");
+      return bad_spec(spec, "this build has no libcamera support (libcamera-dev not found)");
 #endif
   }
   return bad_spec(spec, "unknown source");

@@ -48,6 +48,7 @@ struct ControlLocks {
 struct SourceOptions {
   // Requested image geometry and rate; a V4L2 driver may adjust them and the
   // source reports what was negotiated (describe()).
+  // (ceilposed asks for camera.width x camera.height, the calibrated size.)
   int width = 640;
   int height = 480;
   double fps = 30.0;
@@ -67,10 +68,10 @@ struct SourceOptions {
   int reconnect_initial_ms = 100;
   int reconnect_max_ms = 5000;
 
-  // Replay: pace by the recorded timestamps divided by replay_speed, or
-  // deliver as fast as the consumer takes frames; optionally loop forever.
+  // Replay: pace by the recorded timestamps divided by replay_speed (1 =
+  // recorded timing, 2 = twice as fast), or with 0 deliver as fast as the
+  // consumer takes frames (lossless); optionally loop forever.
   double replay_speed = 1.0;
-  bool replay_as_fast_as_possible = false;
   bool replay_loop = false;
 };
 
@@ -124,9 +125,6 @@ class FrameSource {
   State state_ = State::kClosed;
   bool warned_next_state_ = false;
 };
-
-// The SPEC §7 source spec of the synthetic camera.
-inline constexpr std::string_view kSyntheticSourceSpec = "synthetic";
 
 // SPEC §7 source spec: synthetic | replay:DIR | v4l2:/dev/videoN | libcamera[:ID].
 // The returned source is Closed; an unknown spec, a backend not built in, or

@@ -21,7 +21,7 @@ std::string ReplaySource::describe() const {
   if (!reader_) return text + " (not open)";
   char extra[160];
   const auto& k = reader_->camera().intrinsics;
-  if (options_.replay_as_fast_as_possible) {
+  if (as_fast_as_possible()) {
     std::snprintf(extra, sizeof extra, " (%zu frames, %dx%d, as fast as possible%s)", frame_count(),
                   k.width, k.height, options_.replay_loop ? ", loop" : "");
   } else {
@@ -32,8 +32,9 @@ std::string ReplaySource::describe() const {
 }
 
 Result<void> ReplaySource::do_open() {
-  if (!options_.replay_as_fast_as_possible && !(options_.replay_speed > 0.0)) {
-    return make_error("replay:" + dir_ + ": replay speed must be > 0, got " +
+  if (!(options_.replay_speed >= 0.0)) {
+    return make_error("replay:" + dir_ +
+                      ": replay speed must be >= 0 (0: as fast as possible), got " +
                       std::to_string(options_.replay_speed));
   }
   auto reader = RecordingReader::open(dir_);
@@ -69,7 +70,7 @@ NextStatus ReplaySource::do_next(Frame* out, int timeout_ms) {
   const RecordingRow& row = rows[next_row_];
   const int64_t now_ns = monotonic_ns();
   int64_t due_ns = now_ns;
-  if (!options_.replay_as_fast_as_possible) {
+  if (!as_fast_as_possible()) {
     const double recorded_ns =
         static_cast<double>(row.timestamp_ns - rows.front().timestamp_ns + loop_offset_ns_);
     due_ns = start_ns_ + static_cast<int64_t>(std::llround(recorded_ns / options_.replay_speed));

@@ -25,7 +25,7 @@ class ReplaySource final : public FrameSource {
 
   std::string describe() const override;
   SourceStats stats() const override { return stats_; }
-  bool live() const override { return !options_.replay_as_fast_as_possible; }
+  bool live() const override { return !as_fast_as_possible(); }
   int buffers() const override { return pool_.size(); }
   bool camera_intrinsics(CameraIntrinsics* out) const override {
     if (!reader_) return false;
@@ -37,6 +37,7 @@ class ReplaySource final : public FrameSource {
   size_t frame_count() const { return reader_ ? reader_->rows().size() : 0; }
 
  protected:
+  bool as_fast_as_possible() const { return options_.replay_speed == 0.0; }
   Result<void> do_open() override;
   Result<void> do_start() override;
   NextStatus do_next(Frame* out, int timeout_ms) override;

@@ -264,29 +264,21 @@ class Reader {
 
 void check_cross_keys(Reader& r, const ServiceConfig& c) {
   const PipelineConfig& p = c.pipeline;
-  r.require(c.capture.width_px == p.intrinsics.width, "capture.width_px",
-            "expected the camera calibration's width camera.width = " +
-                std::to_string(p.intrinsics.width) + ", found " +
-                std::to_string(c.capture.width_px));
-  r.require(c.capture.height_px == p.intrinsics.height, "capture.height_px",
-            "expected the camera calibration's height camera.height = " +
-                std::to_string(p.intrinsics.height) + ", found " +
-                std::to_string(c.capture.height_px));
   r.require(p.layout.height_m > p.mount.lens_height_m, "ceiling.height_m",
             "expected a ceiling above the lens (mount.lens_height_m = " +
                 number_text(p.mount.lens_height_m) + "), found " + number_text(p.layout.height_m));
-  r.require(c.capture.reconnect_max_ms >= c.capture.reconnect_initial_ms,
-            "capture.reconnect_max_ms",
-            "expected at least capture.reconnect_initial_ms = " +
-                std::to_string(c.capture.reconnect_initial_ms) + ", found " +
-                std::to_string(c.capture.reconnect_max_ms));
+  const capture::SourceOptions& s = c.capture.device;
   r.require(
-      c.capture.pipeline_rt_priority == 0 || c.capture.rt_priority == 0 ||
-          c.capture.pipeline_rt_priority < c.capture.rt_priority,
-      "capture.pipeline_rt_priority",
-      "expected a priority below capture.rt_priority = " + std::to_string(c.capture.rt_priority) +
-          " (the capture thread must preempt it), found " +
-          std::to_string(c.capture.pipeline_rt_priority));
+      s.reconnect_max_ms >= s.reconnect_initial_ms, "capture.reconnect_max_ms",
+      "expected at least capture.reconnect_initial_ms = " + std::to_string(s.reconnect_initial_ms) +
+          ", found " + std::to_string(s.reconnect_max_ms));
+  const int capture_priority = c.capture.thread.realtime_priority;
+  r.require(c.capture.pipeline_rt_priority == 0 || capture_priority == 0 ||
+                c.capture.pipeline_rt_priority < capture_priority,
+            "capture.pipeline_rt_priority",
+            "expected a priority below capture.rt_priority = " + std::to_string(capture_priority) +
+                " (the capture thread must preempt it), found " +
+                std::to_string(c.capture.pipeline_rt_priority));
   const double marker_n_m = (p.layout.bits - 1) * p.layout.slot_pitch_m;
   r.require(marker_n_m < p.layout.rect_height_m, "ceiling.slot_pitch_m",
             "expected all " + std::to_string(p.layout.bits) +

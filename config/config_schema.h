@@ -9,6 +9,7 @@
 #include <string>
 #include <utility>
 
+#include "capture/source_spec.h"
 #include "config/service_config.h"
 #include "pipeline/marker_observation.h"
 
@@ -21,13 +22,8 @@ using Choices = std::initializer_list<std::pair<const char*, T>>;
 using TextCheck = const char* (*)(const std::string& value);
 
 inline const char* check_source(const std::string& s) {
-  constexpr const char* kExpected =
-      "a source: synthetic | replay:DIR | v4l2:/dev/videoN | libcamera[:ID]";
-  if (s == "synthetic" || s == "libcamera") return nullptr;
-  if (s.rfind("replay:", 0) == 0 && s.size() > 7) return nullptr;
-  if (s.rfind("v4l2:/dev/", 0) == 0 && s.size() > 10) return nullptr;
-  if (s.rfind("libcamera:", 0) == 0 && s.size() > 10) return nullptr;
-  return kExpected;
+  static const std::string expected = "a source: " + std::string(capture::kSourceSpecForms);
+  return capture::parse_source_spec(s) ? nullptr : expected.c_str();
 }
 
 inline const char* check_shm_name(const std::string& s) {
@@ -173,36 +169,37 @@ void describe(V& v, ServiceConfig& c) {
   });
   v.section("capture", [&] {
     CaptureConfig& k = c.capture;
+    capture::SourceOptions& s = k.device;
+    capture::ControlLocks& locks = s.controls;
     v.text("source", k.source, &check_source);
-    v.field("width_px", k.width_px, 1, 16384);
-    v.field("height_px", k.height_px, 1, 16384);
-    v.field("fps", k.fps, 0.1, 1000.0);
-    v.choice("pixel_format", k.pixel_format,
-             Choices<std::string>{{"auto", "auto"},
-                                  {"yuyv", "yuyv"},
-                                  {"mjpeg", "mjpeg"},
-                                  {"rgb24", "rgb24"},
-                                  {"bgr24", "bgr24"},
-                                  {"gray8", "gray8"}});
-    v.field("buffer_count", k.buffer_count, 2, 32);
-    v.field("rt_priority", k.rt_priority, 0, 99);
-    v.field("cpu", k.cpu, -1, 1023);
+    v.field("fps", s.fps, 0.1, 1000.0);
+    using Formats = std::vector<PixelFormat>;
+    v.choice("pixel_format", s.pixel_formats,
+             Choices<Formats>{{"auto", capture::SourceOptions{}.pixel_formats},
+                              {"yuyv", Formats{PixelFormat::kYuyv}},
+                              {"mjpeg", Formats{PixelFormat::kMjpeg}},
+                              {"rgb24", Formats{PixelFormat::kRgb24}},
+                              {"bgr24", Formats{PixelFormat::kBgr24}},
+                              {"gray8", Formats{PixelFormat::kGray8}}});
+    v.field("buffer_count", s.buffer_count, 2, 32);
+    v.field("rt_priority", k.thread.realtime_priority, 0, 99);
+    v.field("cpu", k.thread.cpu, -1, 1023);
     v.field("pipeline_rt_priority", k.pipeline_rt_priority, 0, 99);
-    v.field("lock_exposure", k.lock_exposure);
-    v.field("exposure_us", k.exposure_us, 1, 10'000'000);
-    v.field("lock_gain", k.lock_gain);
-    v.field("gain", k.gain, -1, 1'000'000);
-    v.field("lock_white_balance", k.lock_white_balance);
-    v.field("white_balance_k", k.white_balance_k, 1000, 20000);
-    v.field("stall_timeout_ms", k.stall_timeout_ms, 10, 600'000);
-    v.field("reconnect_initial_ms", k.reconnect_initial_ms, 1, 600'000);
-    v.field("reconnect_max_ms", k.reconnect_max_ms, 1, 600'000);
-    v.field("replay_speed", k.replay_speed, 0.0, 1000.0);
-    v.field("replay_loop", k.replay_loop);
+    v.field("lock_exposure", locks.lock_exposure);
+    v.field("exposure_us", locks.exposure_us, 1, 10'000'000);
+    v.field("lock_gain", locks.lock_gain);
+    v.field("gain", locks.gain, -1, 1'000'000);
+    v.field("lock_white_balance", locks.lock_white_balance);
+    v.field("white_balance_k", locks.white_balance_k, 1000, 20000);
+    v.field("stall_timeout_ms", s.stall_timeout_ms, 10, 600'000);
+    v.field("reconnect_initial_ms", s.reconnect_initial_ms, 1, 600'000);
+    v.field("reconnect_max_ms", s.reconnect_max_ms, 1, 600'000);
+    v.field("replay_speed", s.replay_speed, 0.0, 1000.0);
+    v.field("replay_loop", s.replay_loop);
     v.field("synthetic_seed", k.synthetic_seed, uint64_t{0}, UINT64_MAX);
   });
   v.section("ipc", [&] {
-    v.text("shm_name", c.ipc.shm_name, &check_shm_name);
+    v.text("shm_name", c.ipc.name, &check_shm_name);
     v.text("group", c.ipc.group, &check_any_text);
     v.field("stale_after_ms", c.ipc.stale_after_ms, 1, 600'000);
   });

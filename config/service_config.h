@@ -8,49 +8,28 @@
 #include <utility>
 #include <vector>
 
+#include "capture/capture_thread.h"
+#include "capture/frame_source.h"
 #include "core/result.h"
+#include "ipc/shm/shm_pose_writer.h"
 #include "pipeline/pipeline_config.h"
 #include "pipeline/pose_estimate.h"
 
 namespace ceilpose {
 
-// Where frames come from and how the capture thread runs (issue 4).
+// Where frames come from and how the capture and pipeline threads run. The
+// source's and the capture thread's settings are capture's own option structs
+// (their defaults are the configuration's); the frame size is camera.width x
+// camera.height, the size the intrinsics are calibrated at.
 struct CaptureConfig {
-  // synthetic | replay:DIR | v4l2:/dev/videoN | libcamera[:ID]  (SPEC §7)
-  std::string source = "synthetic";
-  int width_px = 640;  // must equal camera.width: intrinsics are calibrated at one size
-  int height_px = 480;
-  double fps = 30.0;
-  std::string pixel_format = "auto";  // auto | yuyv | mjpeg | rgb24 | bgr24 | gray8
-  int buffer_count = 4;               // driver buffers (V4L2 mmap) and ring slots
-  int rt_priority = 50;               // SCHED_FIFO priority of the capture thread; 0 = normal
-  int cpu = -1;                       // CPU the capture thread is pinned to; -1 = any
+  std::string source = "synthetic";  // capture/source_spec.h, SPEC §7
+  capture::SourceOptions device;  // rate, pixel formats, buffers, control locks, recovery, replay
+  capture::CaptureThreadOptions thread;  // SCHED_FIFO priority and CPU of the capture thread
   // SCHED_FIFO priority of the pipeline thread: below the capture thread's so
   // that a frame is never lost to localization, above ordinary load so that a
   // busy machine does not delay the pose. 0 = normal scheduling.
   int pipeline_rt_priority = 40;
-  // Auto exposure, gain and white balance ruin colour thresholds (the thesis's
-  // main failure), so a camera's are locked by default.
-  bool lock_exposure = true;
-  int exposure_us = 8000;  // exposure when locked; short to limit motion blur
-  bool lock_gain = true;
-  int gain = -1;  // analogue gain when locked, driver units; -1 = keep the driver's
-  bool lock_white_balance = true;
-  int white_balance_k = 4600;  // colour temperature when locked; office fluorescent light
-  // Live-device recovery: no frame for this long is an outage; reopening backs
-  // off exponentially between the two bounds.
-  int stall_timeout_ms = 2000;
-  int reconnect_initial_ms = 100;
-  int reconnect_max_ms = 5000;
-  double replay_speed = 1.0;  // 1 = recorded timing, 2 = twice as fast, 0 = as fast as possible
-  bool replay_loop = false;
   uint64_t synthetic_seed = 1;  // noise seed of the synthetic camera
-};
-
-struct IpcConfig {
-  std::string shm_name = "/ceilpose";  // POSIX shared-memory segment name
-  std::string group;                   // group owning the segment (mode 0640); empty = ours
-  int stale_after_ms = 500;            // readers call a pose stale after this long
 };
 
 struct DdsConfig {
@@ -84,7 +63,7 @@ struct ServiceConfig {
   PipelineConfig pipeline;
   PositioningMode positioning_mode = PositioningMode::kAuto;
   CaptureConfig capture;
-  IpcConfig ipc;
+  ShmOptions ipc;  // the shared-memory segment: name, group, stale_after_ms
   DdsConfig dds;
   LoggingConfig logging;
   WatchdogConfig watchdog;

@@ -10,6 +10,7 @@
 
 #include "capture/frame_source.h"
 #include "capture/pixel_convert.h"
+#include "capture/source_spec.h"
 #include "core/clock.h"
 #include "ctl/command_registry.h"
 #include "recording/recording_writer.h"
@@ -51,7 +52,7 @@ int fail(int code, const std::string& message) {
 }
 
 int run_record(const RecordArgs& a) {
-  const bool replay = a.source.starts_with("replay:");
+  const bool replay = capture::is_replay_spec(a.source);
   if (a.frames <= 0 && a.duration_s <= 0.0 && !replay) {
     return fail(kExitUsage, "a live source needs --frames N or --duration S");
   }
@@ -59,9 +60,9 @@ int run_record(const RecordArgs& a) {
   options.width = a.width;
   options.height = a.height;
   options.fps = a.fps;
-  options.replay_as_fast_as_possible = !a.realtime_replay;
+  if (!a.realtime_replay) options.replay_speed = 0.0;  // as fast as possible
   std::shared_ptr<FrameGenerator> generator;
-  if (a.source == capture::kSyntheticSourceSpec) {
+  if (capture::is_synthetic_spec(a.source)) {
     sim::TrajectoryCameraOptions camera;
     camera.scene.seed = a.seed;
     generator = std::make_shared<sim::TrajectoryCamera>(camera);
@@ -162,9 +163,7 @@ void add_record_command(CLI::App& app) {
       "libcamera[:ID] (exposure, gain and white balance locked). Progress on stderr. Exit 1 "
       "when the source or the writer fails, 2 on a bad command line, 4 when a replayed "
       "recording is malformed.");
-  cmd->add_option("--source", args->source,
-                  "synthetic | replay:DIR | v4l2:/dev/videoN | libcamera[:ID]")
-      ->required();
+  cmd->add_option("--source", args->source, std::string(capture::kSourceSpecForms))->required();
   cmd->add_option("--out", args->out_dir,
                   "Recording directory to create (must not exist or be empty)")
       ->required();

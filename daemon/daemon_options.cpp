@@ -3,6 +3,7 @@
 #include <CLI/CLI.hpp>
 #include <cstdio>
 
+#include "capture/source_spec.h"
 #include "daemon/exit_codes.h"
 
 namespace ceilpose::daemon {
@@ -24,8 +25,7 @@ bool parse_command_line(int argc, char** argv, DaemonOptions* options, int* exit
   // reported by the loader like any other.
   app.add_option("--config", options->config_path,
                  "YAML configuration file (config/ceilpose.yaml)");
-  app.add_option("--source", source,
-                 "frame source: synthetic | replay:DIR | v4l2:/dev/videoN | libcamera[:ID]");
+  app.add_option("--source", source, "frame source: " + std::string(capture::kSourceSpecForms));
   app.add_option("--robot", robot, "robot name, the DDS topic prefix (default: host name)");
   app.add_option("--shm", shm, "shared-memory segment name (default /ceilpose)");
   app.add_option("--domain", domain, "DDS domain id (default 0)");

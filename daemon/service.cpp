@@ -14,6 +14,7 @@
 
 #include "capture/capture_thread.h"
 #include "capture/frame_source.h"
+#include "capture/source_spec.h"
 #include "core/clock.h"
 #include "daemon/exit_codes.h"
 #include "daemon/logging.h"
@@ -47,41 +48,18 @@ bool live_key(const std::string& key) {
   return false;
 }
 
-std::vector<PixelFormat> pixel_formats(const std::string& name) {
-  if (name == "yuyv") return {PixelFormat::kYuyv};
-  if (name == "mjpeg") return {PixelFormat::kMjpeg};
-  if (name == "rgb24") return {PixelFormat::kRgb24};
-  if (name == "bgr24") return {PixelFormat::kBgr24};
-  if (name == "gray8") return {PixelFormat::kGray8};
-  return capture::SourceOptions{}.pixel_formats;  // auto: the backend's preference order
-}
-
+// The configured source options at the calibrated frame size.
 capture::SourceOptions source_options(const ServiceConfig& c) {
-  capture::SourceOptions o;
-  o.width = c.capture.width_px;
-  o.height = c.capture.height_px;
-  o.fps = c.capture.fps;
-  o.pixel_formats = pixel_formats(c.capture.pixel_format);
-  o.buffer_count = c.capture.buffer_count;
-  o.controls.lock_exposure = c.capture.lock_exposure;
-  o.controls.exposure_us = c.capture.exposure_us;
-  o.controls.lock_gain = c.capture.lock_gain;
-  o.controls.gain = c.capture.gain;
-  o.controls.lock_white_balance = c.capture.lock_white_balance;
-  o.controls.white_balance_k = c.capture.white_balance_k;
-  o.stall_timeout_ms = c.capture.stall_timeout_ms;
-  o.reconnect_initial_ms = c.capture.reconnect_initial_ms;
-  o.reconnect_max_ms = c.capture.reconnect_max_ms;
-  o.replay_as_fast_as_possible = c.capture.replay_speed == 0.0;
-  o.replay_speed = o.replay_as_fast_as_possible ? 1.0 : c.capture.replay_speed;
-  o.replay_loop = c.capture.replay_loop;
+  capture::SourceOptions o = c.capture.device;
+  o.width = c.pipeline.intrinsics.width;
+  o.height = c.pipeline.intrinsics.height;
   return o;
 }
 
 // The synthetic camera shows the configured ceiling through the configured
 // camera and mount; other sources need no generator.
 std::shared_ptr<FrameGenerator> frame_generator(const ServiceConfig& c) {
-  if (c.capture.source != capture::kSyntheticSourceSpec) return nullptr;
+  if (!capture::is_synthetic_spec(c.capture.source)) return nullptr;
   sim::TrajectoryCameraOptions o;
   o.scene = sim::SceneOptions{c.pipeline.layout, c.pipeline.intrinsics, c.capture.synthetic_seed};
   o.mount = c.pipeline.mount;
@@ -192,10 +170,8 @@ int Service::start() {
     spdlog::error("frame source: {}", source.error().message);
     return kExitSourceFailure;
   }
-  capture::CaptureThreadOptions copts;
-  copts.realtime_priority = config_.capture.rt_priority;
-  copts.cpu = config_.capture.cpu;
-  capture_ = std::make_unique<capture::CaptureThread>(std::move(source).value(), copts);
+  capture_ =
+      std::make_unique<capture::CaptureThread>(std::move(source).value(), config_.capture.thread);
   if (auto r = capture_->start(); !r) {
     spdlog::error("frame source {}: {}", config_.capture.source, r.error().message);
     return kExitSourceFailure;
@@ -203,7 +179,7 @@ int Service::start() {
   // A recording carries its own camera (recording.yaml), as `ceilposectl
   // locate` uses it; a live camera's calibration is the configuration's job.
   CameraIntrinsics recorded;
-  if (config_.capture.source.rfind("replay:", 0) == 0 && capture_->camera_intrinsics(&recorded)) {
+  if (capture::is_replay_spec(config_.capture.source) && capture_->camera_intrinsics(&recorded)) {
     replay_intrinsics_ = recorded;
     spdlog::info(
         "camera model from the recording: {}x{} px, fx {} fy {} cx {} cy {} (configuration's "
@@ -217,11 +193,7 @@ int Service::start() {
       rt.pinned ? ", pinned" : "", rt.memory_locked ? ", memory locked" : "");
 
   // 2. Shared memory.
-  ShmOptions sopts;
-  sopts.name = config_.ipc.shm_name;
-  sopts.group = config_.ipc.group;
-  sopts.stale_after_ms = config_.ipc.stale_after_ms;
-  auto shm = ShmPoseWriter::create(sopts);
+  auto shm = ShmPoseWriter::create(config_.ipc);
   if (!shm) {
     spdlog::error("shared memory: {}", shm.error().message);
     return kExitRuntime;

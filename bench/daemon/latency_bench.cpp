@@ -96,14 +96,11 @@ void BM_FrameToPose(benchmark::State& state, bool replay) {
   const bool loaded = state.range(1) != 0;
 
   ServiceConfig config = default_config();
-  config.capture.fps = fps;
-  config.capture.cpu = 0;  // capture on CPU 0; the load (if any) on CPU 1
+  config.capture.device.fps = fps;
+  config.capture.thread.cpu = 0;  // capture on CPU 0; the load (if any) on CPU 1
   config.watchdog.status_interval_ms = 1000;
   std::string spec = "synthetic";
-  capture::SourceOptions so;
-  so.width = config.capture.width_px;
-  so.height = config.capture.height_px;
-  so.fps = fps;
+  capture::SourceOptions so = config.capture.device;
   sim::TrajectoryCameraOptions camera;
   camera.scene = sim::SceneOptions{config.pipeline.layout, config.pipeline.intrinsics, 1};
   camera.mount = config.pipeline.mount;
@@ -120,10 +117,7 @@ void BM_FrameToPose(benchmark::State& state, bool replay) {
       state.SkipWithError(source.error().message.c_str());
       return;
     }
-    capture::CaptureThreadOptions copts;
-    copts.realtime_priority = config.capture.rt_priority;
-    copts.cpu = config.capture.cpu;
-    capture::CaptureThread capture(std::move(source).value(), copts);
+    capture::CaptureThread capture(std::move(source).value(), config.capture.thread);
     if (auto r = capture.start(); !r) {
       state.SkipWithError(r.error().message.c_str());
       return;

@@ -49,8 +49,7 @@ class ReplaySourceTest : public ::testing::Test {
 
   SourceOptions options(bool fast, double speed = 1.0, bool loop = false) {
     SourceOptions o;
-    o.replay_as_fast_as_possible = fast;
-    o.replay_speed = speed;
+    o.replay_speed = fast ? 0.0 : speed;
     o.replay_loop = loop;
     return o;
   }

@@ -112,9 +112,25 @@ TEST(ConfigLoader, DuplicateKeyIsAnError) {
               HasSubstr("test.yaml:3: camera.fx: key appears twice"));
 }
 
-TEST(ConfigLoader, CaptureSizeMustMatchCalibration) {
+TEST(ConfigLoader, TheCaptureSizeIsTheCalibrationsNotASecondKey) {
+  // The frame size is camera.width x camera.height; a second key could only
+  // contradict it.
   EXPECT_THAT(error_of("capture:\n  width_px: 1280\n"),
-              HasSubstr("test.yaml:2: capture.width_px: expected the camera calibration's width"));
+              HasSubstr("test.yaml:2: unknown key 'capture.width_px'"));
+}
+
+TEST(ConfigLoader, SourceGrammarIsCapturesOwn) {
+  // The same parser as make_frame_source(): a relative V4L2 path and an empty
+  // replay are refused in the file as on the command line.
+  for (const char* bad : {"v4l2:video0", "replay:", "libcamera:", "webcam", ""})
+    EXPECT_THAT(error_of(std::string("capture:\n  source: \"") + bad + "\"\n"),
+                HasSubstr("capture.source: expected a source: synthetic | replay:DIR"))
+        << bad;
+  for (const char* good : {"v4l2:/tmp/fake-video0", "replay:rec", "libcamera", "libcamera:1"}) {
+    auto r =
+        load_config_string(std::string("capture:\n  source: \"") + good + "\"\n", "test.yaml");
+    EXPECT_TRUE(r.ok()) << good << ": " << r.error().message;
+  }
 }
 
 TEST(ConfigLoader, TopLevelListIsAnError) {
@@ -154,7 +170,7 @@ TEST(ConfigOverrides, BadValueNamesTheOption) {
 TEST(ConfigDiff, NamesExactlyTheChangedKeys) {
   ServiceConfig changed = default_config();
   changed.pipeline.detector.min_rect_area_px += 1;
-  changed.capture.fps = 60.0;
+  changed.capture.device.fps = 60.0;
   EXPECT_EQ(changed_config_keys(default_config(), changed),
             (std::vector<std::string>{"detector.min_rect_area_px", "capture.fps"}));
 }
