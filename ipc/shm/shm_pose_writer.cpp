@@ -390,4 +390,8 @@ uint64_t ShmPoseWriter::generation() const { return impl_->seg->header.generatio
 uint64_t ShmPoseWriter::last_seq() const { return impl_->seq; }
 uint64_t ShmPoseWriter::wake_syscalls() const { return impl_->wake_syscalls; }
 
+uint32_t ShmPoseWriter::waiting_readers() const {
+  return impl_->wake->waiters.load(std::memory_order_seq_cst);
+}
+
 }  // namespace ceilpose

@@ -69,6 +69,9 @@ class ShmPoseWriter {
   // FUTEX_WAKE calls made so far: publish() makes one only when a reader is
   // registered as waiting, so this stays 0 with no blocked readers.
   uint64_t wake_syscalls() const;
+  // Readers registered as blocked in wait_next right now (the -wake
+  // segment's count), e.g. for a test to publish only once one sleeps.
+  uint32_t waiting_readers() const;
 
  private:
   struct Impl;

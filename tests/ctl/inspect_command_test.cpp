@@ -72,9 +72,6 @@ TEST_P(MalformedRecordingCommand, InspectExitsWithBadInputAndNamesTheDefect) {
 }
 
 TEST_P(MalformedRecordingCommand, LocateReplayExitsNonZeroAndNamesTheDefect) {
-  if (!has_subcommand("locate")) {
-    GTEST_SKIP() << "this ceilposectl has no `locate` sub-command yet";
-  }
   const MalformedCase& mc = GetParam();
   const std::string d = malformed_recording(mc, tmp_);
   const CommandOutput r = run_ceilposectl({"locate", "--replay", d});

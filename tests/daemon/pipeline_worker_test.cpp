@@ -99,6 +99,38 @@ TEST(PipelineWorker, SnapshotsAndReloadsFromAnotherThreadKeepTheSequenceRising) 
   EXPECT_EQ(rig.shm->last_seq(), worker.frames());
 }
 
+// Waits (bounded) until a snapshot satisfies `ok`.
+template <typename Pred>
+bool wait_snapshot(const PipelineWorker& worker, Pred ok) {
+  for (int i = 0; i < 3000; ++i) {
+    if (ok(worker.latest())) return true;
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  }
+  return false;
+}
+
+TEST(PipelineWorker, AReloadTakesEffectOnTheFollowingFrames) {
+  // Handshakes on what the frames show, not on time: a rectangle size no
+  // marker has makes every frame refused, and putting it back restores poses.
+  Rig rig;
+  PipelineWorker worker(rig.config, WorkerOptions{}, rig.capture.get(), rig.sinks, &rig.progress);
+  worker.start();
+  ASSERT_TRUE(wait_snapshot(worker, [](const PoseSnapshot& s) { return s.valid; }));
+  ServiceConfig blind = rig.config;
+  blind.pipeline.detector.min_rect_area_px = 1 << 23;
+  blind.pipeline.filter.enabled = false;  // no coasting through the refused frames
+  worker.reload(blind, true);
+  ASSERT_TRUE(wait_snapshot(worker, [](const PoseSnapshot& s) {
+    return !s.valid && s.refusal == Refusal::kNoMarkers;
+  })) << "the reload never reached the pipeline thread";
+  const uint64_t refused_before = worker.refusals()[Refusal::kNoMarkers];
+  worker.reload(rig.config, true);
+  ASSERT_TRUE(wait_snapshot(worker, [](const PoseSnapshot& s) { return s.valid; }))
+      << "the second reload never reached the pipeline thread";
+  worker.stop();
+  EXPECT_GT(refused_before, 0u);
+}
+
 TEST(PipelineWorker, StatusRecordReachesReaders) {
   Rig rig;
   PipelineWorker worker(rig.config, WorkerOptions{}, rig.capture.get(), rig.sinks, &rig.progress);

@@ -1,5 +1,8 @@
-// Golden end-to-end accuracy over simulator sets: render, detect, position,
-// and assert issue 3's accuracy table (docs/accuracy.md).
+// Golden end-to-end accuracy over simulator sets: render, detect, position
+// through the Localizer, and assert limits near what is measured (no looser
+// than 2x the median and p99 measured at 200 frames on 2026-12-01, so that a
+// 2x regression fails; docs/accuracy.md has the figures). Under sanitizers
+// fewer frames run (accuracy_frames); their p99 stays below these limits.
 #include <gtest/gtest.h>
 
 #include <iostream>
@@ -17,7 +20,7 @@ void print_row(const std::string& name, const AccuracyReport& r) {
             << " frames)\n";
 }
 
-// One row of issue 3's accuracy table; gross errors are always 0.
+// One set's limits; gross errors are always 0.
 struct TableRow {
   const char* set;
   PositioningMode mode;
@@ -41,16 +44,20 @@ void expect_row(const TableRow& row) {
   EXPECT_EQ(r.gross, 0);
 }
 
-TEST(Accuracy, NominalSetMeetsIssueTable) {
-  expect_row({"nominal", PositioningMode::kAuto, 1.0, 0.999, 3.0, 10.0, 0.5});
+// Measured at 200 frames: median / p99 position error, yaw p99.
+TEST(Accuracy, NominalSetStaysNearItsMeasuredAccuracy) {
+  // 0.05 / 0.21 mm, 0.008 deg
+  expect_row({"nominal", PositioningMode::kAuto, 1.0, 1.0, 0.10, 0.42, 0.016});
 }
 
-TEST(Accuracy, StressSetMeetsIssueTable) {
-  expect_row({"stress", PositioningMode::kAuto, 0.98, 0.99, 6.0, 20.0, 1.0});
+TEST(Accuracy, StressSetStaysNearItsMeasuredAccuracy) {
+  // 0.14 / 0.38 mm, 0.025 deg
+  expect_row({"stress", PositioningMode::kAuto, 1.0, 1.0, 0.28, 0.76, 0.05});
 }
 
-TEST(Accuracy, TiltedCameraWithLeastSquaresMeetsIssueTable) {
-  expect_row({"tilt", PositioningMode::kLeastSquares, 0.99, 0.99, 5.0, 15.0, 1.0});
+TEST(Accuracy, TiltedCameraWithLeastSquaresStaysNearItsMeasuredAccuracy) {
+  // 0.48 / 2.84 mm, 0.009 deg
+  expect_row({"tilt", PositioningMode::kLeastSquares, 1.0, 1.0, 0.96, 5.7, 0.018});
 }
 
 TEST(Accuracy, FramesWithoutWholeMarkerAreInvalidAndEdgesHaveNoGrossError) {
@@ -60,6 +67,10 @@ TEST(Accuracy, FramesWithoutWholeMarkerAreInvalidAndEdgesHaveNoGrossError) {
   ASSERT_LT(r.frames_with_whole, r.frames) << "the set must contain frames with no whole marker";
   EXPECT_EQ(r.valid_without_whole, 0);
   EXPECT_EQ(r.gross, 0);
+  // Measured: availability 99.4 %, 0.12 / 5.03 mm.
+  EXPECT_GE(r.availability, 0.96);
+  EXPECT_LE(r.median_error_mm, 0.24);
+  EXPECT_LE(r.p99_error_mm, 10.0);
 }
 
 // The daemon's filter on a patrol at 1.2 m/s with U-turns: smoothing must not
@@ -68,17 +79,20 @@ TEST(Accuracy, FilteredTrajectoryKeepsPerFrameAccuracy) {
   const AccuracyReport r = testing::run_scenario("trajectory", testing::accuracy_frames(300), kSeed,
                                                  PositioningMode::kAuto, /*filter=*/true);
   print_row("trajectory, filtered", r);
+  // Measured at 300 frames: 0.24 / 0.72 mm, yaw p99 0.072 deg.
   EXPECT_EQ(r.availability, 1.0);
-  EXPECT_GE(r.within_both, 0.999);
-  EXPECT_LE(r.p99_error_mm, 10.0);
-  EXPECT_LE(r.yaw_p99_deg, 0.5);
+  EXPECT_EQ(r.within_both, 1.0);
+  EXPECT_LE(r.median_error_mm, 0.48);
+  EXPECT_LE(r.p99_error_mm, 1.44);
+  EXPECT_LE(r.yaw_p99_deg, 0.144);
   EXPECT_EQ(r.gross, 0);
 }
 
 // The thesis reports its modes at its static test points as the share of
 // samples within ±0.05 grid units per axis: Barycentric 89–98%, Change of
 // Axes 90–100%. Ours must be at least the thesis's best on both axes.
-void expect_thesis_mode(PositioningMode mode, double min_within_per_axis) {
+void expect_thesis_mode(PositioningMode mode, double min_within_per_axis, double max_median_mm,
+                        double max_p99_mm, double max_yaw_p99_deg) {
   const AccuracyReport r =
       testing::run_scenario("thesis_points", testing::accuracy_frames(200), kSeed, mode);
   print_row("thesis points (" + std::string(to_string(mode)) + ")", r);
@@ -86,15 +100,20 @@ void expect_thesis_mode(PositioningMode mode, double min_within_per_axis) {
   EXPECT_GE(r.within_x, min_within_per_axis);
   EXPECT_GE(r.within_y, min_within_per_axis);
   EXPECT_EQ(r.mode_count[static_cast<int>(mode)], r.valid);
+  EXPECT_LE(r.median_error_mm, max_median_mm);
+  EXPECT_LE(r.p99_error_mm, max_p99_mm);
+  EXPECT_LE(r.yaw_p99_deg, max_yaw_p99_deg);
   EXPECT_EQ(r.gross, 0);
 }
 
 TEST(Accuracy, ChangeOfAxesAtThesisPointsAtLeastMatchesThesis) {
-  expect_thesis_mode(PositioningMode::kChangeOfAxes, 1.0);
+  // Measured: 0.34 / 1.77 mm, yaw p99 0.26 deg.
+  expect_thesis_mode(PositioningMode::kChangeOfAxes, 1.0, 0.68, 3.54, 0.52);
 }
 
 TEST(Accuracy, BarycentricAtThesisPointsAtLeastMatchesThesis) {
-  expect_thesis_mode(PositioningMode::kBarycentric, 0.98);
+  // Measured: 0.06 / 0.14 mm, yaw p99 0.21 deg.
+  expect_thesis_mode(PositioningMode::kBarycentric, 1.0, 0.12, 0.28, 0.42);
 }
 
 }  // namespace

@@ -159,8 +159,8 @@ TEST_F(LocateCommand, MalformedRecordingExitsFourNamingFileAndLine) {
   }
   const CommandRun r = run("locate --replay " + rec.string());
   EXPECT_EQ(r.exit_code, 4);
-  EXPECT_NE(r.err.find("frames.csv"), std::string::npos) << r.err;
-  EXPECT_NE(r.err.find('4'), std::string::npos) << "line 4 named: " << r.err;
+  EXPECT_NE(r.err.find("frames.csv:4:"), std::string::npos) << "file and line 4 named: " << r.err;
+  EXPECT_NE(r.err.find("banana"), std::string::npos) << "the bad value named: " << r.err;
   EXPECT_TRUE(r.out.empty());
 }
 

@@ -18,16 +18,31 @@ using test::ForkedChild;
 
 class ShmFutex : public test::ShmFixture {};
 
+// The handshake instead of a sleep: true once a reader is registered as
+// blocked on `writer` (bounded, so a reader that never blocks fails).
+bool until_a_reader_waits(const ShmPoseWriter& writer) {
+  const int64_t deadline_ns = monotonic_ns() + 30'000'000'000;
+  while (writer.waiting_readers() == 0) {
+    if (monotonic_ns() > deadline_ns) return false;
+    std::this_thread::yield();
+  }
+  return true;
+}
+
 TEST_F(ShmFutex, WaitNextWakesOnPublish) {
   ASSERT_NO_FATAL_FAILURE(start());
+  bool waited = false;
   std::thread publisher([&] {
-    std::this_thread::sleep_for(std::chrono::milliseconds(50));
+    waited = until_a_reader_waits(writer());
     writer().publish(check_pose(1));
   });
   PoseRecord p;
   EXPECT_EQ(reader().wait_next(0, 30'000, &p), WaitResult::kPose);
   EXPECT_EQ(p.seq, 1u);
   publisher.join();
+  EXPECT_TRUE(waited) << "the reader never registered as blocked";
+  EXPECT_EQ(writer().wake_syscalls(), 1u) << "the publish woke the blocked reader";
+  EXPECT_EQ(writer().waiting_readers(), 0u) << "the woken reader deregistered";
 }
 
 TEST_F(ShmFutex, WaitNextTimesOutWithoutPublish) {
@@ -64,21 +79,19 @@ TEST_F(ShmFutex, PublishWithBlockedWaiterMakesWakeSyscall) {
     PoseRecord p;
     EXPECT_EQ(reader().wait_next(0, 30'000, &p), WaitResult::kPose);
   });
-  // Publish only once the waiter is registered: until then wake_syscalls stays 0.
-  uint64_t k = 0;
-  while (writer().wake_syscalls() == 0 && k < 1'000'000) {
-    std::this_thread::sleep_for(std::chrono::milliseconds(20));
-    writer().publish(check_pose(++k));
-  }
+  // Before the waiter registers, publishing makes no wake syscall.
+  EXPECT_EQ(writer().wake_syscalls(), 0u);
+  ASSERT_TRUE(until_a_reader_waits(writer()));
+  writer().publish(check_pose(1));
   waiter.join();
-  EXPECT_GE(writer().wake_syscalls(), 1u);
+  EXPECT_EQ(writer().wake_syscalls(), 1u);
 }
 
 TEST_F(ShmFutex, ReaderProcessIsWokenByWriterProcess) {
   ForkedChild child(test::writer_child(name(), [](ShmPoseWriter& writer, ForkedChild& self) {
     self.notify_parent();
     if (!self.wait_for_parent(20'000)) return 11;
-    std::this_thread::sleep_for(std::chrono::milliseconds(50));
+    if (!until_a_reader_waits(writer)) return 13;  // the parent blocks in another process
     writer.publish(check_pose(1));
     return self.wait_for_parent(20'000) ? 0 : 12;
   }));
