@@ -19,6 +19,7 @@
 #include "daemon/exit_codes.h"
 #include "daemon/logging.h"
 #include "daemon/pipeline_worker.h"
+#include "daemon/pose_printer.h"
 #include "daemon/problem_report.h"
 #include "daemon/shm_pose_sink.h"
 #include "daemon/signal_channel.h"
@@ -66,6 +67,26 @@ std::shared_ptr<FrameGenerator> frame_generator(const ServiceConfig& c) {
   return std::make_shared<sim::TrajectoryCamera>(o);
 }
 
+#ifdef CEILPOSE_DAEMON_HAVE_DDS
+// The publisher's options from dds.*; an empty robot name is the host's, as
+// a ROS name.
+DdsOptions dds_options(const ServiceConfig& c) {
+  DdsOptions o;
+  o.robot = c.dds.robot_name;
+  if (o.robot.empty()) {
+    char host[256] = {};
+    gethostname(host, sizeof(host) - 1);
+    o.robot = to_ros_name(host);
+  }
+  o.domain.domain_id = static_cast<uint32_t>(c.dds.domain_id);
+  o.domain.interfaces = c.dds.interfaces;
+  o.domain.peers = c.dds.peers;
+  o.reliability = c.dds.reliable ? DdsReliability::kReliable : DdsReliability::kBestEffort;
+  o.history_depth = c.dds.history_depth;
+  return o;
+}
+#endif
+
 // Test hook, documented in docs/service.md: only tests set it.
 uint64_t stall_after_frames_from_env() {
   const char* env = std::getenv("CEILPOSE_TEST_STALL_AFTER_FRAMES");
@@ -78,50 +99,6 @@ uint64_t stall_after_frames_from_env() {
   return n;
 }
 
-const char* fix_name(FixState fix) { return to_string(fix); }
-
-std::string status_line(const PoseSnapshot& s, const capture::FrameLatency& latency) {
-  const capture::LatencySummary lat = latency.dequeue_to_published().summary();
-  char buf[200];
-  std::snprintf(buf, sizeof(buf), "fix %s, %d markers, %.1f fps, latency p50 %.2f ms p99 %.2f ms",
-                fix_name(s.fix), s.markers, s.fps, static_cast<double>(lat.p50_us) / 1000.0,
-                static_cast<double>(lat.p99_us) / 1000.0);
-  return buf;
-}
-
-void print_pose(const PoseSnapshot& s, int64_t start_ns) {
-  constexpr double kDeg = 180.0 / std::numbers::pi;
-  const double t_s = static_cast<double>(s.capture_ns - start_ns) * 1e-9;
-  char line[320];
-  int n = 0;
-  if (s.valid) {
-    n = std::snprintf(
-        line, sizeof(line), "t=%8.3f s  x=%8.4f m  y=%8.4f m  yaw=%8.2f deg  %-11s %2d markers",
-        t_s, s.pose.x_m, s.pose.y_m, s.pose.yaw_rad * kDeg,
-        s.fix == FixState::kCoasting ? "coasting" : std::string(to_string(s.mode)).c_str(),
-        s.markers);
-  } else {
-    const std::string_view why = to_string(s.refusal);
-    n = std::snprintf(line, sizeof(line), "t=%8.3f s  no pose (%s: %.*s)%*s %2d markers", t_s,
-                      fix_name(s.fix), static_cast<int>(why.size()), why.data(), 16, "", s.markers);
-  }
-  if (s.has_ground_truth && n > 0 && n < static_cast<int>(sizeof(line))) {
-    const Pose2D& g = s.ground_truth;
-    n += std::snprintf(line + n, sizeof(line) - n, "  | truth x=%8.4f y=%8.4f yaw=%8.2f", g.x_m,
-                       g.y_m, g.yaw_rad * kDeg);
-    if (s.valid && n < static_cast<int>(sizeof(line))) {
-      const double err_mm = 1000.0 * std::hypot(s.pose.x_m - g.x_m, s.pose.y_m - g.y_m);
-      const double yaw_err = wrap_angle_rad(s.pose.yaw_rad - g.yaw_rad) * kDeg;
-      n += std::snprintf(line + n, sizeof(line) - n, "  err %6.1f mm %6.2f deg", err_mm, yaw_err);
-    }
-  }
-  if (n > 0 && n < static_cast<int>(sizeof(line)))
-    std::snprintf(line + n, sizeof(line) - n, "  | latency %.2f ms",
-                  static_cast<double>(s.latency_ns) * 1e-6);
-  std::printf("%s\n", line);
-  std::fflush(stdout);
-}
-
 class Service {
  public:
   Service(const ServiceConfig& config, const DaemonOptions& options)
@@ -130,7 +107,12 @@ class Service {
   int run();
 
  private:
+  // start() runs the steps in order; each returns kExitOk or the exit code.
   int start();
+  int start_capture();
+  int start_shared_memory();
+  int start_dds();
+  int start_pipeline();
   void loop();
   void reload();
   void shutdown();
@@ -163,7 +145,16 @@ class Service {
 
 int Service::start() {
   start_ns_ = monotonic_ns();
-  // 1. Capture: opens the source on its own thread.
+  for (int (Service::*step)() : {&Service::start_capture, &Service::start_shared_memory,
+                                 &Service::start_dds, &Service::start_pipeline}) {
+    if (const int rc = (this->*step)(); rc != kExitOk) return rc;
+  }
+  notifier_.ready("running, waiting for the first frame");
+  return kExitOk;
+}
+
+// The capture thread opens the source on its own thread.
+int Service::start_capture() {
   auto source = capture::make_frame_source(config_.capture.source, source_options(config_),
                                            frame_generator(config_));
   if (!source) {
@@ -191,8 +182,10 @@ int Service::start() {
       "capture: {} ({}{}{})", capture_->description(),
       rt.fifo ? "SCHED_FIFO " + std::to_string(rt.priority) : std::string("normal priority"),
       rt.pinned ? ", pinned" : "", rt.memory_locked ? ", memory locked" : "");
+  return kExitOk;
+}
 
-  // 2. Shared memory.
+int Service::start_shared_memory() {
   auto shm = ShmPoseWriter::create(config_.ipc);
   if (!shm) {
     spdlog::error("shared memory: {}", shm.error().message);
@@ -201,39 +194,29 @@ int Service::start() {
   shm_.emplace(std::move(shm).value());
   shm_sink_.emplace(&*shm_, config_.watchdog.status_interval_ms);
   sinks_.push_back(&*shm_sink_);
+  return kExitOk;
+}
 
-  // 3. DDS.
+int Service::start_dds() {
 #ifdef CEILPOSE_DAEMON_HAVE_DDS
-  if (config_.dds.enabled) {
-    DdsOptions dopts;
-    dopts.robot = config_.dds.robot_name;
-    if (dopts.robot.empty()) {
-      char host[256] = {};
-      gethostname(host, sizeof(host) - 1);
-      dopts.robot = to_ros_name(host);
-    }
-    dopts.domain.domain_id = static_cast<uint32_t>(config_.dds.domain_id);
-    dopts.domain.interfaces = config_.dds.interfaces;
-    dopts.domain.peers = config_.dds.peers;
-    dopts.reliability = config_.dds.reliable ? ceilpose::DdsReliability::kReliable
-                                             : ceilpose::DdsReliability::kBestEffort;
-    dopts.history_depth = config_.dds.history_depth;
-    auto pub = DdsPosePublisher::create(dopts);
-    if (!pub) {
-      spdlog::error("DDS: {}", pub.error().message);
-      return kExitRuntime;
-    }
-    dds_.emplace(std::move(pub).value());
-    dds_sink_.emplace(&*dds_, config_.dds.status_period_ms);
-    sinks_.push_back(&*dds_sink_);
-    spdlog::info("DDS: domain {} topic {}, status every {} ms", dds_->domain_id(),
-                 dds_->pose_topic(), config_.dds.status_period_ms);
+  if (!config_.dds.enabled) return kExitOk;
+  auto pub = DdsPosePublisher::create(dds_options(config_));
+  if (!pub) {
+    spdlog::error("DDS: {}", pub.error().message);
+    return kExitRuntime;
   }
+  dds_.emplace(std::move(pub).value());
+  dds_sink_.emplace(&*dds_, config_.dds.status_period_ms);
+  sinks_.push_back(&*dds_sink_);
+  spdlog::info("DDS: domain {} topic {}, status every {} ms", dds_->domain_id(), dds_->pose_topic(),
+               config_.dds.status_period_ms);
 #else
   if (config_.dds.enabled) spdlog::warn("DDS: not built into this ceilposed; shared memory only");
 #endif
+  return kExitOk;
+}
 
-  // 4. Pipeline thread.
+int Service::start_pipeline() {
   WorkerOptions wopts;
   wopts.stall_after_frames = stall_after_frames_from_env();
   wopts.rt_priority = config_.capture.pipeline_rt_priority;
@@ -249,7 +232,6 @@ int Service::start() {
                to_string(config_.positioning_mode), config_.pipeline.filter.enabled ? "on" : "off",
                worker_->realtime() ? ", pipeline SCHED_FIFO " + std::to_string(wopts.rt_priority)
                                    : std::string());
-  notifier_.ready("running, waiting for the first frame");
   return kExitOk;
 }
 

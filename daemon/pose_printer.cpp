@@ -1,0 +1,53 @@
+#include "daemon/pose_printer.h"
+
+#include <cmath>
+#include <cstdio>
+#include <numbers>
+#include <string_view>
+
+namespace ceilpose::daemon {
+
+std::string status_line(const PoseSnapshot& s, const capture::FrameLatency& latency) {
+  const capture::LatencySummary lat = latency.dequeue_to_published().summary();
+  char buf[200];
+  std::snprintf(buf, sizeof(buf), "fix %s, %d markers, %.1f fps, latency p50 %.2f ms p99 %.2f ms",
+                to_string(s.fix), s.markers, s.fps, static_cast<double>(lat.p50_us) / 1000.0,
+                static_cast<double>(lat.p99_us) / 1000.0);
+  return buf;
+}
+
+void print_pose(const PoseSnapshot& s, int64_t start_ns) {
+  constexpr double kDeg = 180.0 / std::numbers::pi;
+  const double t_s = static_cast<double>(s.capture_ns - start_ns) * 1e-9;
+  char line[320];
+  int n = 0;
+  if (s.valid) {
+    n = std::snprintf(
+        line, sizeof(line), "t=%8.3f s  x=%8.4f m  y=%8.4f m  yaw=%8.2f deg  %-11s %2d markers",
+        t_s, s.pose.x_m, s.pose.y_m, s.pose.yaw_rad * kDeg,
+        s.fix == FixState::kCoasting ? "coasting" : std::string(to_string(s.mode)).c_str(),
+        s.markers);
+  } else {
+    const std::string_view why = to_string(s.refusal);
+    n = std::snprintf(line, sizeof(line), "t=%8.3f s  no pose (%s: %.*s)%*s %2d markers", t_s,
+                      to_string(s.fix), static_cast<int>(why.size()), why.data(), 16, "",
+                      s.markers);
+  }
+  if (s.has_ground_truth && n > 0 && n < static_cast<int>(sizeof(line))) {
+    const Pose2D& g = s.ground_truth;
+    n += std::snprintf(line + n, sizeof(line) - n, "  | truth x=%8.4f y=%8.4f yaw=%8.2f", g.x_m,
+                       g.y_m, g.yaw_rad * kDeg);
+    if (s.valid && n < static_cast<int>(sizeof(line))) {
+      const double err_mm = 1000.0 * std::hypot(s.pose.x_m - g.x_m, s.pose.y_m - g.y_m);
+      const double yaw_err = wrap_angle_rad(s.pose.yaw_rad - g.yaw_rad) * kDeg;
+      n += std::snprintf(line + n, sizeof(line) - n, "  err %6.1f mm %6.2f deg", err_mm, yaw_err);
+    }
+  }
+  if (n > 0 && n < static_cast<int>(sizeof(line)))
+    std::snprintf(line + n, sizeof(line) - n, "  | latency %.2f ms",
+                  static_cast<double>(s.latency_ns) * 1e-6);
+  std::printf("%s\n", line);
+  std::fflush(stdout);
+}
+
+}  // namespace ceilpose::daemon
