@@ -12,6 +12,7 @@
 
 #include "capture/wait.h"
 #include "core/clock.h"
+#include "core/futex.h"
 
 namespace ceilpose::capture {
 namespace {
@@ -125,8 +126,8 @@ void CaptureThread::run(void* start_promise) {
       const uint32_t seen = returned_seq_.load(std::memory_order_acquire);
       drain_returned();
       if (in_flight_ >= budget_) {
-        futex_wait(&returned_seq_, seen,
-                   static_cast<int64_t>(options_.next_timeout_ms) * 1'000'000);
+        futex_wait(&returned_seq_, seen, static_cast<int64_t>(options_.next_timeout_ms) * 1'000'000,
+                   FutexScope::kProcess);
       }
       continue;
     }
@@ -140,7 +141,7 @@ void CaptureThread::run(void* start_promise) {
         ++in_flight_;
         frames_.fetch_add(1, std::memory_order_relaxed);
         ready_seq_.fetch_add(1, std::memory_order_release);
-        futex_wake_all(&ready_seq_);
+        futex_wake_all(&ready_seq_, FutexScope::kProcess);
       }
     } else if (s == NextStatus::kEndOfStream || s == NextStatus::kError) {
       if (s == NextStatus::kError) failed_.store(true, std::memory_order_release);
@@ -151,7 +152,7 @@ void CaptureThread::run(void* start_promise) {
   publish_source_stats();
   finished_.store(true, std::memory_order_release);
   ready_seq_.fetch_add(1, std::memory_order_release);
-  futex_wake_all(&ready_seq_);
+  futex_wake_all(&ready_seq_, FutexScope::kProcess);
   // The pipeline may still hold frames or have some in the ring: they stay
   // valid (the source keeps its buffers) until this object is destroyed.
   drain_returned();
@@ -195,7 +196,7 @@ bool CaptureThread::acquire_latest(Frame* out, int timeout_ms) {
     if (finished_.load(std::memory_order_acquire) && ready_.front() == nullptr) return false;
     const int64_t remaining_ns = deadline_ns - monotonic_ns();
     if (remaining_ns <= 0) return false;
-    futex_wait(&ready_seq_, seen, remaining_ns);
+    futex_wait(&ready_seq_, seen, remaining_ns, FutexScope::kProcess);
   }
 }
 
@@ -206,7 +207,7 @@ void CaptureThread::return_to_capture(const Frame& frame) {
   // source, so the return ring always has room for each of them.
   [[maybe_unused]] const bool ok = returned_.try_push(frame);
   returned_seq_.fetch_add(1, std::memory_order_release);
-  if (!live_) futex_wake_all(&returned_seq_);
+  if (!live_) futex_wake_all(&returned_seq_, FutexScope::kProcess);
 }
 
 CaptureStats CaptureThread::stats() const {

@@ -68,7 +68,8 @@ class FrameLatency {
   const LatencyHistogram& capture_to_dequeue() const { return capture_to_dequeue_; }
   const LatencyHistogram& dequeue_to_pipeline() const { return dequeue_to_pipeline_; }
   const LatencyHistogram& pipeline_to_published() const { return pipeline_to_published_; }
-  // Frame ready (dequeued) to pose published: the figure issue 4 budgets.
+  // Frame ready (dequeued) to pose published: the figure the service's
+  // latency budget (under 1 ms) is about.
   const LatencyHistogram& dequeue_to_published() const { return dequeue_to_published_; }
   const LatencyHistogram& capture_to_published() const { return capture_to_published_; }
 

@@ -99,7 +99,7 @@ Result<void> V4l2Source::do_open() {
 Result<void> V4l2Source::open_device() {
   const int fd = sys_->open(path_.c_str(), O_RDWR | O_NONBLOCK | O_CLOEXEC);
   if (fd < 0) return make_error("Failed to open " + path_ + ": " + err(fd));
-  fd_ = UniqueFd(sys_, fd);
+  fd_ = UniqueFd(fd, sys_);
   if (auto r = query_capabilities(); !r) {
     fd_.reset();
     return r;

@@ -45,7 +45,6 @@ class V4l2Source final : public FrameSource {
   double fps() const { return fps_; }
   // Whether the driver stamps buffers on CLOCK_MONOTONIC (else dequeue time is used).
   bool driver_timestamps() const { return driver_timestamps_; }
-  bool recovering() const { return recovering_; }
 
  protected:
   Result<void> do_open() override;

@@ -7,16 +7,17 @@
 #include <sys/types.h>
 
 #include <cstddef>
-#include <utility>
+
+#include "core/unique_fd.h"
 
 namespace ceilpose::capture {
 
-class V4l2Syscalls {
+class V4l2Syscalls : public FdCloser {
  public:
   virtual ~V4l2Syscalls() = default;
   // open(2) of a device node; >= 0 is the fd.
   virtual int open(const char* path, int flags) = 0;
-  virtual int close(int fd) = 0;
+  int close(int fd) override = 0;
   // ioctl(2), retried on EINTR; 0 (or the ioctl's non-negative result) or -errno.
   virtual int ioctl(int fd, unsigned long request, void* arg) = 0;
   // mmap(2) of a buffer, PROT_READ|PROT_WRITE, MAP_SHARED. 0 and *out, or -errno.
@@ -28,35 +29,5 @@ class V4l2Syscalls {
 
 // The real syscalls; stateless, shared by all sources.
 V4l2Syscalls& real_v4l2_syscalls();
-
-// Owns one device fd and closes it through the syscalls it came from.
-class UniqueFd {
- public:
-  UniqueFd() = default;
-  UniqueFd(V4l2Syscalls* sys, int fd) : sys_(sys), fd_(fd) {}
-  ~UniqueFd() { reset(); }
-  UniqueFd(UniqueFd&& o) noexcept : sys_(o.sys_), fd_(std::exchange(o.fd_, -1)) {}
-  UniqueFd& operator=(UniqueFd&& o) noexcept {
-    if (this != &o) {
-      reset();
-      sys_ = o.sys_;
-      fd_ = std::exchange(o.fd_, -1);
-    }
-    return *this;
-  }
-  UniqueFd(const UniqueFd&) = delete;
-  UniqueFd& operator=(const UniqueFd&) = delete;
-
-  int get() const { return fd_; }
-  bool valid() const { return fd_ >= 0; }
-  void reset() {
-    if (fd_ >= 0) sys_->close(fd_);
-    fd_ = -1;
-  }
-
- private:
-  V4l2Syscalls* sys_ = nullptr;
-  int fd_ = -1;
-};
 
 }  // namespace ceilpose::capture

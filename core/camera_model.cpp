@@ -22,9 +22,7 @@ Mat3 mat_mul(const Mat3& a, const Mat3& b) {
   return c;
 }
 
-Mat3 mat_transpose(const Mat3& a) {
-  return {a[0], a[3], a[6], a[1], a[4], a[7], a[2], a[5], a[8]};
-}
+Mat3 mat_transpose(const Mat3& a) { return {a[0], a[3], a[6], a[1], a[4], a[7], a[2], a[5], a[8]}; }
 
 Vec3 mat_vec(const Mat3& a, const Vec3& v) {
   return {a[0] * v[0] + a[1] * v[1] + a[2] * v[2], a[3] * v[0] + a[4] * v[1] + a[5] * v[2],

@@ -28,9 +28,9 @@ struct CameraMount {
   double lens_height_m = 0.3048;
   double offset_forward_m = 0.0;
   double offset_left_m = 0.0;
-  double yaw_rad = 0.0;         // camera forward (image up) relative to robot forward, CCW
-  double tilt_x_rad = 0.0;      // rotation about the camera's Xc axis (image right)
-  double tilt_y_rad = 0.0;      // rotation about the camera's Yc axis (image down)
+  double yaw_rad = 0.0;     // camera forward (image up) relative to robot forward, CCW
+  double tilt_x_rad = 0.0;  // rotation about the camera's Xc axis (image right)
+  double tilt_y_rad = 0.0;  // rotation about the camera's Yc axis (image down)
 };
 
 // Rigid camera pose in the world: p_world = R_wc * p_cam + t_w.
@@ -54,8 +54,7 @@ Vec3 mat_vec(const Mat3& a, const Vec3& v);
 void distort_normalized(const CameraIntrinsics& k, double x, double y, double* xd, double* yd);
 
 // Camera-frame point to pixel. Returns false when the point is behind the camera.
-bool project_camera_point(const CameraIntrinsics& k, const Vec3& p_cam, double* u_px,
-                          double* v_px);
+bool project_camera_point(const CameraIntrinsics& k, const Vec3& p_cam, double* u_px, double* v_px);
 
 // World point to pixel for a given camera pose.
 bool project_world_point(const CameraIntrinsics& k, const CameraPose& pose, const Vec3& p_world,

@@ -16,14 +16,14 @@ struct Rgb {
 };
 
 struct CeilingLayout {
-  double height_m = 2.4384;   // ceiling plane z = H
-  double grid_m = 0.6096;     // marker spacing g
-  int bits = 3;               // bits per rectangle; codes 0 .. 2^bits - 1
+  double height_m = 2.4384;  // ceiling plane z = H
+  double grid_m = 0.6096;    // marker spacing g
+  int bits = 3;              // bits per rectangle; codes 0 .. 2^bits - 1
   // Marker geometry in the marker frame (e East, n North), SPEC §2 table.
   double rect_width_m = 5.0 * kInch_m;    // E–W extent of each rectangle
   double rect_height_m = 12.0 * kInch_m;  // N–S extent
   double slot_pitch_m = 4.0 * kInch_m;
-  double green_dot_e_m = 3.0 * kInch_m;   // full axes
+  double green_dot_e_m = 3.0 * kInch_m;  // full axes
   double green_dot_n_m = 2.0 * kInch_m;
   double red_dot_e_m = 2.0 * kInch_m;
   double red_dot_n_m = 1.0 * kInch_m;

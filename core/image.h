@@ -12,11 +12,15 @@ enum class PixelFormat : uint8_t { kGray8, kRgb24, kBgr24, kYuyv, kMjpeg };
 
 inline int bytes_per_pixel(PixelFormat f) {
   switch (f) {
-    case PixelFormat::kGray8: return 1;
+    case PixelFormat::kGray8:
+      return 1;
     case PixelFormat::kRgb24:
-    case PixelFormat::kBgr24: return 3;
-    case PixelFormat::kYuyv: return 2;
-    case PixelFormat::kMjpeg: return 0;
+    case PixelFormat::kBgr24:
+      return 3;
+    case PixelFormat::kYuyv:
+      return 2;
+    case PixelFormat::kMjpeg:
+      return 0;
   }
   return 0;
 }

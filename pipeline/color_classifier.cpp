@@ -3,7 +3,8 @@
 #include <cmath>
 #include <cstdlib>
 
-// Method (issue 3, "thresholds that adapt to exposure and white balance").
+// Method: thresholds that adapt to exposure and white balance, because fixed
+// ones were the thesis's main failure under changing light.
 //
 // The thesis classified in HSV with fixed thresholds; auto-exposure and
 // colour casts then moved the colours out of their windows. Here every frame

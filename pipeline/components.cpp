@@ -3,7 +3,8 @@
 #include <cmath>
 #include <cstring>
 
-// One sweep, row by row (issue 3, "runs → components in the same sweep"):
+// One sweep, row by row, runs joined into components as they are found (one
+// pass over the pixels):
 //   a. classify the row into a byte buffer through the fused lookup (one
 //      table lookup per pixel, no colour-space conversion pass);
 //   b. run-length encode it, skipping background eight bytes at a time; a

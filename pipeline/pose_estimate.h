@@ -10,7 +10,8 @@
 
 namespace ceilpose {
 
-// Positioning methods (issue 3): the thesis's two, and least squares over all.
+// Positioning methods: the thesis's two (one marker, three markers), and least
+// squares over all markers, which uses every point the view offers.
 enum class PositioningMode : uint8_t {
   kAuto = 0,
   kChangeOfAxes = 1,

@@ -120,11 +120,11 @@ void occlusion(Context& c, Effects& e) { e.occlusion_fraction = c.rng(0.05, 0.35
 void clutter(Context&, Effects& e) { e.clutter_objects = kMaxClutterObjects / 2; }
 
 void stress(Context& c, Effects& e) {
-  // The combined levels of issue 3's accuracy table. Occlusion is left out on
+  // The combined levels of the project's stress accuracy target. Occlusion is left out on
   // purpose: it hides whole markers that availability counts as in view.
   e.gain = c.rng(0.45, 1.6);
   for (double& m : e.white_balance) m = c.rng(0.75, 1.25);
-  e.read_noise_sigma = 6.0;  // issue 3 says sigma 6: no shot noise on top
+  e.read_noise_sigma = 6.0;  // the stress target says sigma 6: no shot noise on top
   e.defocus_sigma_px = c.rng(0.5, 1.2);
   e.motion_blur_px = c.rng(0.0, 3.0);
   e.motion_blur_angle_rad = c.rng(-kPi, kPi);
@@ -170,7 +170,7 @@ constexpr std::array<Entry, 17> kEntries{{
      &thesis_points, nullptr},
     {"random", "uniform random poses over the grid interior, random yaw, clean camera", nullptr,
      &clean},
-    {"nominal", "uniform random poses, read noise sigma 0.5-3 levels (issue 3 'nominal')", nullptr,
+    {"nominal", "uniform random poses, read noise sigma 0.5-3 levels (the 'nominal' accuracy set)", nullptr,
      &nominal},
     {"trajectory",
      "patrol loop over the grid at 1.2 m/s (lanes joined by U-turns of one grid unit radius), 30 "
@@ -191,7 +191,7 @@ constexpr std::array<Entry, 17> kEntries{{
     {"occlusion", "random poses, a dark occluder covering 5-35% of the image", nullptr, &occlusion},
     {"clutter", "random poses, 16 red/green non-marker objects on the ceiling", nullptr, &clutter},
     {"stress",
-     "all effects combined at issue 3 levels: gain 0.45-1.6, +-25% colour cast, noise sigma 6, "
+     "all effects combined at the stress target's levels: gain 0.45-1.6, +-25% colour cast, noise sigma 6, "
      "defocus 0.5-1.2 px, motion blur <= 3 px, gradient <= 30%, bloom 0.1, 6 clutter objects, "
      "JPEG 60 (no occlusion)",
      nullptr, &stress},

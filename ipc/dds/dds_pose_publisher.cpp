@@ -64,10 +64,9 @@ Result<DdsPosePublisher> DdsPosePublisher::create(const DdsOptions& options) {
 
 Result<void> DdsPosePublisher::publish(const DdsPose& pose) {
   if (!participant_.valid()) return make_error("DDS publisher of " + robot_ + " was disposed");
-  if (!pose.valid) {
-    ++skipped_invalid_;
-    return {};
-  }
+  // The daemon's DDS sink never passes one; a caller that does has a bug,
+  // and ROS consumers would take the pose as a fix.
+  if (!pose.valid) return make_error("refusing to publish an invalid pose on " + pose_topic_);
   geometry_msgs_msg_dds__PoseWithCovarianceStamped_ msg;
   to_message(pose, &msg);
   const dds_return_t rc = dds_write(pose_writer_, &msg);

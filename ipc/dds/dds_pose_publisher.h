@@ -26,9 +26,9 @@ class DdsPosePublisher {
   DdsPosePublisher(DdsPosePublisher&&) noexcept = default;
   DdsPosePublisher& operator=(DdsPosePublisher&&) noexcept = default;
 
-  // Per-frame path: no allocation on success. An invalid pose is not
-  // published (ROS consumers would take any pose on the topic as a fix); it
-  // is counted in skipped_invalid() and the status topic reports no fix.
+  // Per-frame path: no allocation on success. An invalid pose is refused
+  // with an error (ROS consumers would take any pose on the topic as a fix):
+  // callers publish valid poses only, and the status topic reports no fix.
   Result<void> publish(const DdsPose& pose);
   Result<void> publish_status(const DdsStatus& status);
 
@@ -44,7 +44,6 @@ class DdsPosePublisher {
   // process is the cheapest for discovery); 0 after dispose().
   dds_entity_t participant_handle() const { return participant_.handle(); }
   uint64_t published() const { return published_; }
-  uint64_t skipped_invalid() const { return skipped_invalid_; }
 
  private:
   DdsPosePublisher() = default;
@@ -56,7 +55,6 @@ class DdsPosePublisher {
   std::string pose_topic_;
   std::string status_topic_;
   uint64_t published_ = 0;
-  uint64_t skipped_invalid_ = 0;
 };
 
 }  // namespace ceilpose

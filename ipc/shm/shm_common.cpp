@@ -27,25 +27,6 @@ bool valid_shm_name(const std::string& name) {
 
 std::string wake_segment_name(const std::string& name) { return name + "-wake"; }
 
-FileDescriptor& FileDescriptor::operator=(FileDescriptor&& other) noexcept {
-  if (this != &other) {
-    reset();
-    fd_ = other.release();
-  }
-  return *this;
-}
-
-int FileDescriptor::release() {
-  const int fd = fd_;
-  fd_ = -1;
-  return fd;
-}
-
-void FileDescriptor::reset() {
-  if (fd_ >= 0) ::close(fd_);
-  fd_ = -1;
-}
-
 Mapping::Mapping(Mapping&& other) noexcept
     : address_(other.address_), size_bytes_(other.size_bytes_) {
   other.address_ = nullptr;
@@ -78,25 +59,6 @@ Mapping map_shared(int fd, size_t size_bytes, bool writable, int* error) {
   }
   *error = 0;
   return Mapping(p, size_bytes);
-}
-
-int futex_wait_shared(const void* word, uint32_t expected, int64_t timeout_ns) {
-  timespec ts{};
-  timespec* tsp = nullptr;
-  if (timeout_ns >= 0) {
-    ts.tv_sec = static_cast<time_t>(timeout_ns / 1'000'000'000);
-    ts.tv_nsec = static_cast<long>(timeout_ns % 1'000'000'000);
-    tsp = &ts;
-  }
-  // Not FUTEX_PRIVATE_FLAG: the word is shared between processes, and the
-  // kernel keys it by the backing page, so different mappings meet.
-  const long rc = ::syscall(SYS_futex, word, FUTEX_WAIT, expected, tsp, nullptr, 0);
-  return rc == 0 ? 0 : -errno;
-}
-
-int futex_wake_shared(const void* word) {
-  const long rc = ::syscall(SYS_futex, word, FUTEX_WAKE, INT_MAX, nullptr, nullptr, 0);
-  return rc >= 0 ? static_cast<int>(rc) : -errno;
 }
 
 bool process_exists(int pid) {

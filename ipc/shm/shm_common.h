@@ -7,6 +7,7 @@
 #include <string>
 
 #include "core/result.h"
+#include "core/unique_fd.h"
 
 namespace ceilpose::shm {
 
@@ -33,25 +34,6 @@ Error fail(ShmErrc* out, ShmErrc code, std::string message);
 bool valid_shm_name(const std::string& name);
 std::string wake_segment_name(const std::string& name);
 
-class FileDescriptor {
- public:
-  FileDescriptor() = default;
-  explicit FileDescriptor(int fd) : fd_(fd) {}
-  ~FileDescriptor() { reset(); }
-  FileDescriptor(FileDescriptor&& other) noexcept : fd_(other.release()) {}
-  FileDescriptor& operator=(FileDescriptor&& other) noexcept;
-  FileDescriptor(const FileDescriptor&) = delete;
-  FileDescriptor& operator=(const FileDescriptor&) = delete;
-
-  int get() const { return fd_; }
-  bool valid() const { return fd_ >= 0; }
-  int release();
-  void reset();
-
- private:
-  int fd_ = -1;
-};
-
 class Mapping {
  public:
   Mapping() = default;
@@ -73,13 +55,6 @@ class Mapping {
 
 // mmap(MAP_SHARED) of `size_bytes` of `fd`; returns -errno in *error on failure.
 Mapping map_shared(int fd, size_t size_bytes, bool writable, int* error);
-
-// FUTEX_WAIT on a shared (inter-process) word while it still equals
-// `expected`, for at most timeout_ns (< 0: forever). Returns 0 when woken,
-// -EAGAIN if the word differed, -ETIMEDOUT, -EINTR.
-int futex_wait_shared(const void* word, uint32_t expected, int64_t timeout_ns);
-// Wakes every waiter on the word; returns how many or -errno.
-int futex_wake_shared(const void* word);
 
 // kill(pid, 0): true unless the process certainly does not exist (ESRCH).
 bool process_exists(int pid);

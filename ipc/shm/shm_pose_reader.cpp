@@ -12,12 +12,12 @@
 #include <limits>
 
 #include "core/clock.h"
+#include "core/futex.h"
 #include "ipc/shm/shm_layout.h"
 
 namespace ceilpose {
 
 using shm::fail;
-using shm::FileDescriptor;
 using shm::Mapping;
 using shm::Segment;
 using shm::ShmErrc;
@@ -110,9 +110,9 @@ const char* to_string(Liveness l) {
 
 struct ShmPoseReader::Impl {
   std::string name;
-  FileDescriptor fd;
+  UniqueFd fd;
   Mapping mapping;
-  FileDescriptor wake_fd;
+  UniqueFd wake_fd;
   Mapping wake_mapping;
   const Segment* seg = nullptr;
   WakeSegment* wake = nullptr;
@@ -133,7 +133,7 @@ Result<ShmPoseReader> ShmPoseReader::open(const std::string& name, ShmErrc* code
                 "invalid shm segment name '" + name +
                     "': must be '/' followed by 1-249 characters without '/'");
   }
-  FileDescriptor fd(::shm_open(name.c_str(), O_RDONLY | O_CLOEXEC, 0));
+  UniqueFd fd(::shm_open(name.c_str(), O_RDONLY | O_CLOEXEC, 0));
   if (!fd.valid()) {
     const int e = errno;
     if (e == ENOENT) {
@@ -206,7 +206,7 @@ Result<ShmPoseReader> ShmPoseReader::open(const std::string& name, ShmErrc* code
   }
 
   const std::string wake_name = shm::wake_segment_name(name);
-  FileDescriptor wake_fd(::shm_open(wake_name.c_str(), O_RDWR | O_CLOEXEC, 0));
+  UniqueFd wake_fd(::shm_open(wake_name.c_str(), O_RDWR | O_CLOEXEC, 0));
   if (!wake_fd.valid()) {
     const int e = errno;
     if (e == EACCES) {
@@ -259,7 +259,7 @@ Result<ShmPoseReader> ShmPoseReader::open_waiting(const std::string& name, int t
   // Creation shows up as IN_CREATE and sizing as IN_MODIFY; the header's
   // magic is written through the mapping, which inotify cannot see, so the
   // short not-ready window is re-checked on a timer.
-  FileDescriptor watch(::inotify_init1(IN_CLOEXEC | IN_NONBLOCK));
+  UniqueFd watch(::inotify_init1(IN_CLOEXEC | IN_NONBLOCK));
   if (watch.valid()) {
     ::inotify_add_watch(watch.get(), "/dev/shm", IN_CREATE | IN_MOVED_TO | IN_MODIFY);
   }
@@ -328,7 +328,8 @@ WaitResult ShmPoseReader::wait_next(uint64_t after_seq, int timeout_ms, PoseReco
       if (remaining_ns <= 0) {
         timed_out = true;
       } else {
-        rc = shm::futex_wait_shared(&h.wake_seq, word, std::min(remaining_ns, kLivenessCheckNs));
+        rc = futex_wait(&h.wake_seq, word, std::min(remaining_ns, kLivenessCheckNs),
+                        FutexScope::kShared);
       }
     }
     r.wake->waiters.fetch_sub(1, std::memory_order_seq_cst);
@@ -386,7 +387,7 @@ int64_t ShmPoseReader::stale_after_ms(int64_t requested) const {
 uint64_t ShmPoseReader::latest_seq() const { return impl_->latest_seq(); }
 
 bool ShmPoseReader::replaced() const {
-  FileDescriptor fd(::shm_open(impl_->name.c_str(), O_RDONLY | O_CLOEXEC, 0));
+  UniqueFd fd(::shm_open(impl_->name.c_str(), O_RDONLY | O_CLOEXEC, 0));
   if (!fd.valid()) return false;
   struct stat st {};
   if (::fstat(fd.get(), &st) != 0) return false;

@@ -17,12 +17,12 @@
 #include <vector>
 
 #include "core/clock.h"
+#include "core/futex.h"
 #include "ipc/shm/shm_layout.h"
 
 namespace ceilpose {
 
 using shm::fail;
-using shm::FileDescriptor;
 using shm::Mapping;
 using shm::Segment;
 using shm::ShmErrc;
@@ -79,7 +79,7 @@ void wake_readers_of(int fd) {
   int error = 0;
   Mapping m = shm::map_shared(fd, sizeof(Segment), false, &error);
   if (m.get() == nullptr) return;
-  shm::futex_wake_shared(&static_cast<const Segment*>(m.get())->header.wake_seq);
+  futex_wake_all(&static_cast<const Segment*>(m.get())->header.wake_seq, FutexScope::kShared);
 }
 
 uint64_t new_generation() {
@@ -112,9 +112,9 @@ Result<void> set_owner_and_mode(int fd, const std::string& name, mode_t mode, gi
 
 struct ShmPoseWriter::Impl {
   std::string name;
-  FileDescriptor fd;  // holds the flock that marks a live writer
+  UniqueFd fd;  // holds the flock that marks a live writer
   Mapping mapping;
-  FileDescriptor wake_fd;
+  UniqueFd wake_fd;
   Mapping wake_mapping;
   Segment* seg = nullptr;
   WakeSegment* wake = nullptr;
@@ -143,7 +143,7 @@ struct ShmPoseWriter::Impl {
     // sees the other, so a reader never sleeps through a publish.
     seg->header.wake_seq.store(wake_seq, std::memory_order_seq_cst);
     if (always || wake->waiters.load(std::memory_order_seq_cst) != 0) {
-      shm::futex_wake_shared(&seg->header.wake_seq);
+      futex_wake_all(&seg->header.wake_seq, FutexScope::kShared);
       ++wake_syscalls;
     }
   }
@@ -199,10 +199,9 @@ Result<ShmPoseWriter> ShmPoseWriter::create(const ShmOptions& options, ShmErrc* 
   // 1. Create the name exclusively; an existing segment is replaced only when
   //    no live writer holds its lock (flock is dropped by the kernel when the
   //    owner dies, whatever the pid namespace).
-  FileDescriptor fd;
+  UniqueFd fd;
   for (int attempt = 0; attempt < kCreateAttempts && !fd.valid(); ++attempt) {
-    fd = FileDescriptor(
-        ::shm_open(name.c_str(), O_RDWR | O_CREAT | O_EXCL | O_CLOEXEC, kSegmentMode));
+    fd = UniqueFd(::shm_open(name.c_str(), O_RDWR | O_CREAT | O_EXCL | O_CLOEXEC, kSegmentMode));
     if (fd.valid()) break;
     const int e = errno;
     if (e != EEXIST) {
@@ -210,7 +209,7 @@ Result<ShmPoseWriter> ShmPoseWriter::create(const ShmOptions& options, ShmErrc* 
                   "cannot create shm segment " + name + " (mode " + shm::mode_text(kSegmentMode) +
                       "): " + shm::errno_text(e));
     }
-    FileDescriptor old(::shm_open(name.c_str(), O_RDWR | O_CLOEXEC, 0));
+    UniqueFd old(::shm_open(name.c_str(), O_RDWR | O_CLOEXEC, 0));
     if (!old.valid()) {
       const int oe = errno;
       if (oe == ENOENT) continue;  // removed meanwhile: try again
@@ -268,8 +267,7 @@ Result<ShmPoseWriter> ShmPoseWriter::create(const ShmOptions& options, ShmErrc* 
   // 2. The companion "-wake" segment, complete before the main one is.
   const std::string wake_name = shm::wake_segment_name(name);
   ::shm_unlink(wake_name.c_str());  // a stale one, if any; ENOENT is normal
-  FileDescriptor wake_fd(
-      ::shm_open(wake_name.c_str(), O_RDWR | O_CREAT | O_EXCL | O_CLOEXEC, kWakeMode));
+  UniqueFd wake_fd(::shm_open(wake_name.c_str(), O_RDWR | O_CREAT | O_EXCL | O_CLOEXEC, kWakeMode));
   if (!wake_fd.valid()) {
     const int e = errno;
     return fail(code, shm::errc_from_errno(e),

@@ -1,4 +1,4 @@
-// Cross-check (issue 3): the real pipeline on frames from a renderer written
+// Cross-check: the real pipeline on frames from a renderer written
 // from SPEC.md alone (independent_renderer_support.cpp), so that a convention
 // that the pipeline and sim/ both bent the same way would show here. Metrics
 // are recomputed here from SPEC §6's text, not taken from pipeline/.

@@ -142,7 +142,7 @@ TEST_F(PipelineDetectSimTest, BarrelDistortionLeavesTheCentresUnbiased) {
 }
 
 TEST_F(PipelineDetectSimTest, StressFramesStillGiveAlmostEveryWholeMarker) {
-  // Issue 3 stress levels: gain 0.45–1.6, ±25 % cast, noise σ 6, blur,
+  // Stress levels: gain 0.45–1.6, ±25 % cast, noise σ 6, blur,
   // JPEG 60, clutter.
   std::array<PointErrors, 3> e;
   run("stress", 16, &e, 0.97);

@@ -17,7 +17,7 @@ using testing::Part;
 using testing::Point2;
 
 constexpr double kInch = 0.0254;
-// Issue 2 asks for < 0.3 px; the area-integrating renderer measures about
+// The renderer's target is < 0.3 px; the area-integrating renderer measures about
 // 0.005 px, so a tighter bound catches half-pixel convention slips.
 constexpr double kCentroidTolerance_px = 0.05;
 

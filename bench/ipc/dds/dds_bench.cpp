@@ -1,5 +1,5 @@
 // DDS publish -> receive latency on loopback between two processes, beside
-// Cyclone's own ddsperf ping/pong on the same configuration (issue 5, Speed).
+// Cyclone's own ddsperf ping/pong on the same configuration (the yardstick for our DDS path).
 //
 // A child `dds_bench --pong DOMAIN` echoes every pose it receives through its
 // own DdsPosePublisher, from Cyclone's receive thread (a data-available

@@ -34,15 +34,16 @@ TEST_F(DdsPublisher, TopicsCarryTheRobotName) {
   EXPECT_EQ(pub->status_topic(), "rt/" + options_.robot + "/ceilpose_status");
 }
 
-TEST_F(DdsPublisher, InvalidPoseIsCountedNotPublished) {
+TEST_F(DdsPublisher, InvalidPoseIsRefusedNotPublished) {
   auto pub = DdsPosePublisher::create(options_);
   ASSERT_TRUE(pub.ok()) << pub.error().message;
   DdsPose pose;
   pose.valid = false;
-  EXPECT_TRUE(pub->publish(pose).ok());
+  const auto refused = pub->publish(pose);
+  ASSERT_FALSE(refused.ok());
+  EXPECT_NE(refused.error().message.find("invalid pose"), std::string::npos);
   pose.valid = true;
   EXPECT_TRUE(pub->publish(pose).ok());
-  EXPECT_EQ(pub->skipped_invalid(), 1u);
   EXPECT_EQ(pub->published(), 1u);
 }
 
