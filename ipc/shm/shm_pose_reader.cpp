@@ -126,15 +126,21 @@ struct ShmPoseReader::Impl {
   uint64_t latest_seq() const { return header().latest_seq.load(std::memory_order_acquire); }
 };
 
-Result<ShmPoseReader> ShmPoseReader::open(const std::string& name, ShmErrc* code) {
-  if (code != nullptr) *code = ShmErrc::kOk;
-  if (!shm::valid_shm_name(name)) {
-    return fail(code, ShmErrc::kInvalidArgument,
-                "invalid shm segment name '" + name +
-                    "': must be '/' followed by 1-249 characters without '/'");
-  }
-  UniqueFd fd(::shm_open(name.c_str(), O_RDONLY | O_CLOEXEC, 0));
-  if (!fd.valid()) {
+namespace {
+
+// An open segment: its fd, its mapping and what fstat said.
+struct OpenedSegment {
+  UniqueFd fd;
+  Mapping mapping;
+  struct stat st {};
+};
+
+// Opens and maps the pose segment read-only, refusing one too small to hold
+// a header.
+Result<OpenedSegment> open_pose_segment(const std::string& name, ShmErrc* code) {
+  OpenedSegment out;
+  out.fd = UniqueFd(::shm_open(name.c_str(), O_RDONLY | O_CLOEXEC, 0));
+  if (!out.fd.valid()) {
     const int e = errno;
     if (e == ENOENT) {
       return fail(code, ShmErrc::kNotFound,
@@ -148,13 +154,12 @@ Result<ShmPoseReader> ShmPoseReader::open(const std::string& name, ShmErrc* code
     return fail(code, shm::errc_from_errno(e),
                 "cannot open shm segment " + name + ": " + shm::errno_text(e));
   }
-  struct stat st {};
-  if (::fstat(fd.get(), &st) != 0) {
+  if (::fstat(out.fd.get(), &out.st) != 0) {
     const int e = errno;
     return fail(code, ShmErrc::kSystem,
                 "cannot stat shm segment " + name + ": " + shm::errno_text(e));
   }
-  const auto size_bytes = static_cast<size_t>(st.st_size);
+  const auto size_bytes = static_cast<size_t>(out.st.st_size);
   if (size_bytes == 0) {
     return fail(code, ShmErrc::kNotReady,
                 "shm segment " + name + " is empty: its writer is still creating it");
@@ -168,15 +173,21 @@ Result<ShmPoseReader> ShmPoseReader::open(const std::string& name, ShmErrc* code
                     std::to_string(sizeof(Segment)) + " bytes)");
   }
   int map_error = 0;
-  Mapping mapping =
-      shm::map_shared(fd.get(), std::min(size_bytes, sizeof(Segment)), false, &map_error);
-  if (mapping.get() == nullptr) {
+  out.mapping =
+      shm::map_shared(out.fd.get(), std::min(size_bytes, sizeof(Segment)), false, &map_error);
+  if (out.mapping.get() == nullptr) {
     return fail(code, shm::errc_from_errno(map_error),
                 "cannot map shm segment " + name + " (" + std::to_string(size_bytes) +
                     " bytes): " + shm::errno_text(map_error));
   }
-  const auto* seg = static_cast<const Segment*>(mapping.get());
-  const uint64_t magic = seg->header.magic.load(std::memory_order_acquire);
+  return out;
+}
+
+// The header must be complete (magic), ours (magic), of our ABI and of the
+// sizes this ABI lays out.
+Result<void> check_header(const Segment& seg, size_t size_bytes, const std::string& name,
+                          ShmErrc* code) {
+  const uint64_t magic = seg.header.magic.load(std::memory_order_acquire);
   if (magic == 0) {
     return fail(code, ShmErrc::kNotReady,
                 "shm segment " + name + " is not initialized yet: its writer is starting");
@@ -185,7 +196,7 @@ Result<ShmPoseReader> ShmPoseReader::open(const std::string& name, ShmErrc* code
     return fail(code, ShmErrc::kBadMagic,
                 "shm segment " + name + " is not a ceilpose pose segment (bad magic)");
   }
-  const auto& h = seg->header;
+  const auto& h = seg.header;
   if (h.abi_version != shm::kAbiVersion) {
     return fail(code, ShmErrc::kAbiMismatch,
                 "shm segment " + name + " has ABI version " + std::to_string(h.abi_version) +
@@ -204,10 +215,17 @@ Result<ShmPoseReader> ShmPoseReader::open(const std::string& name, ShmErrc* code
                     std::to_string(shm::kRingLength) + ", pose " +
                     std::to_string(sizeof(PoseRecord)) + " bytes");
   }
+  return {};
+}
 
+// Opens and maps the "-wake" companion read-write; it must belong to the
+// pose segment's writer generation.
+Result<OpenedSegment> open_wake_segment(const std::string& name, uint64_t generation,
+                                        ShmErrc* code) {
   const std::string wake_name = shm::wake_segment_name(name);
-  UniqueFd wake_fd(::shm_open(wake_name.c_str(), O_RDWR | O_CLOEXEC, 0));
-  if (!wake_fd.valid()) {
+  OpenedSegment out;
+  out.fd = UniqueFd(::shm_open(wake_name.c_str(), O_RDWR | O_CLOEXEC, 0));
+  if (!out.fd.valid()) {
     const int e = errno;
     if (e == EACCES) {
       return fail(code, ShmErrc::kPermission,
@@ -218,37 +236,56 @@ Result<ShmPoseReader> ShmPoseReader::open(const std::string& name, ShmErrc* code
                 "cannot open shm segment " + wake_name + " (companion of " + name +
                     "): " + shm::errno_text(e));
   }
-  struct stat wst {};
-  if (::fstat(wake_fd.get(), &wst) != 0 ||
-      static_cast<size_t>(wst.st_size) != sizeof(WakeSegment)) {
+  if (::fstat(out.fd.get(), &out.st) != 0 ||
+      static_cast<size_t>(out.st.st_size) != sizeof(WakeSegment)) {
     return fail(code, ShmErrc::kNotReady,
-                "shm segment " + wake_name + " is " + std::to_string(wst.st_size) +
+                "shm segment " + wake_name + " is " + std::to_string(out.st.st_size) +
                     " bytes, expected " + std::to_string(sizeof(WakeSegment)) +
                     " (its writer is starting or replacing it)");
   }
-  Mapping wake_mapping = shm::map_shared(wake_fd.get(), sizeof(WakeSegment), true, &map_error);
-  if (wake_mapping.get() == nullptr) {
+  int map_error = 0;
+  out.mapping = shm::map_shared(out.fd.get(), sizeof(WakeSegment), true, &map_error);
+  if (out.mapping.get() == nullptr) {
     return fail(code, shm::errc_from_errno(map_error),
                 "cannot map shm segment " + wake_name + ": " + shm::errno_text(map_error));
   }
-  auto* wake = static_cast<WakeSegment*>(wake_mapping.get());
+  const auto* wake = static_cast<const WakeSegment*>(out.mapping.get());
   if (wake->magic.load(std::memory_order_acquire) != shm::kWakeMagic ||
-      wake->generation != h.generation) {
+      wake->generation != generation) {
     return fail(code, ShmErrc::kNotReady,
                 "shm segment " + wake_name + " does not belong to " + name +
                     " (its writer is starting or replacing it)");
   }
+  return out;
+}
+
+}  // namespace
+
+Result<ShmPoseReader> ShmPoseReader::open(const std::string& name, ShmErrc* code) {
+  if (code != nullptr) *code = ShmErrc::kOk;
+  if (!shm::valid_shm_name(name)) {
+    return fail(code, ShmErrc::kInvalidArgument,
+                "invalid shm segment name '" + name +
+                    "': must be '/' followed by 1-249 characters without '/'");
+  }
+  auto pose = open_pose_segment(name, code);
+  if (!pose) return pose.error();
+  const auto* seg = static_cast<const Segment*>(pose->mapping.get());
+  if (auto ok = check_header(*seg, static_cast<size_t>(pose->st.st_size), name, code); !ok)
+    return ok.error();
+  auto wake = open_wake_segment(name, seg->header.generation, code);
+  if (!wake) return wake.error();
 
   auto impl = std::make_unique<Impl>();
   impl->name = name;
-  impl->fd = std::move(fd);
-  impl->mapping = std::move(mapping);
-  impl->wake_fd = std::move(wake_fd);
-  impl->wake_mapping = std::move(wake_mapping);
+  impl->dev = pose->st.st_dev;
+  impl->ino = pose->st.st_ino;
   impl->seg = seg;
-  impl->wake = wake;
-  impl->dev = st.st_dev;
-  impl->ino = st.st_ino;
+  impl->wake = static_cast<WakeSegment*>(wake->mapping.get());
+  impl->fd = std::move(pose->fd);
+  impl->mapping = std::move(pose->mapping);
+  impl->wake_fd = std::move(wake->fd);
+  impl->wake_mapping = std::move(wake->mapping);
   return ShmPoseReader(std::move(impl));
 }
 

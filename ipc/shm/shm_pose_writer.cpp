@@ -180,8 +180,9 @@ struct ShmPoseWriter::Impl {
   }
 };
 
-Result<ShmPoseWriter> ShmPoseWriter::create(const ShmOptions& options, ShmErrc* code) {
-  if (code != nullptr) *code = ShmErrc::kOk;
+namespace {
+
+Result<void> check_options(const ShmOptions& options, ShmErrc* code) {
   const std::string& name = options.name;
   if (!shm::valid_shm_name(name)) {
     return fail(code, ShmErrc::kInvalidArgument,
@@ -193,12 +194,13 @@ Result<ShmPoseWriter> ShmPoseWriter::create(const ShmOptions& options, ShmErrc* 
                 "heartbeat period for shm segment " + name + " must be >= 0 ms, got " +
                     std::to_string(options.heartbeat_period_ms));
   }
-  auto gid = lookup_group(options.group, name, code);
-  if (!gid) return gid.error();
+  return {};
+}
 
-  // 1. Create the name exclusively; an existing segment is replaced only when
-  //    no live writer holds its lock (flock is dropped by the kernel when the
-  //    owner dies, whatever the pid namespace).
+// Creates `name` exclusively and locks it. An existing segment is replaced
+// only when no live writer holds its lock (flock is dropped by the kernel when
+// the owner dies, whatever the pid namespace).
+Result<UniqueFd> claim_name(const std::string& name, ShmErrc* code) {
   UniqueFd fd;
   for (int attempt = 0; attempt < kCreateAttempts && !fd.valid(); ++attempt) {
     fd = UniqueFd(::shm_open(name.c_str(), O_RDWR | O_CREAT | O_EXCL | O_CLOEXEC, kSegmentMode));
@@ -248,66 +250,54 @@ Result<ShmPoseWriter> ShmPoseWriter::create(const ShmOptions& options, ShmErrc* 
     return fail(code, ShmErrc::kLiveWriter,
                 "cannot lock new shm segment " + name + ": " + shm::errno_text(le));
   }
+  return fd;
+}
 
-  auto impl = std::make_unique<Impl>();
-  impl->name = name;
-  // Until the segment is complete, any failure removes what was made.
-  struct Cleanup {
-    const std::string* name;
-    bool armed = true;
-    ~Cleanup() {
-      if (!armed) return;
-      ::shm_unlink(name->c_str());
-      ::shm_unlink(shm::wake_segment_name(*name).c_str());
-    }
-  } cleanup{&name};
+// Sizes and maps a segment that `fd` holds.
+Result<Mapping> size_and_map(int fd, const std::string& name, size_t size_bytes, ShmErrc* code) {
+  if (::ftruncate(fd, static_cast<off_t>(size_bytes)) != 0) {
+    const int e = errno;
+    return fail(code, shm::errc_from_errno(e),
+                "cannot size shm segment " + name + " to " + std::to_string(size_bytes) +
+                    " bytes: " + shm::errno_text(e));
+  }
+  int map_error = 0;
+  Mapping mapping = shm::map_shared(fd, size_bytes, true, &map_error);
+  if (mapping.get() == nullptr) {
+    return fail(code, shm::errc_from_errno(map_error),
+                "cannot map shm segment " + name + " (" + std::to_string(size_bytes) +
+                    " bytes): " + shm::errno_text(map_error));
+  }
+  return mapping;
+}
 
-  if (auto r = set_owner_and_mode(fd.get(), name, kSegmentMode, *gid, code); !r) return r.error();
-
-  // 2. The companion "-wake" segment, complete before the main one is.
+// The companion "-wake" segment, complete (magic stored) before the main one.
+Result<void> create_wake_segment(const std::string& name, gid_t gid, uint64_t generation,
+                                 UniqueFd* fd_out, Mapping* mapping_out, ShmErrc* code) {
   const std::string wake_name = shm::wake_segment_name(name);
   ::shm_unlink(wake_name.c_str());  // a stale one, if any; ENOENT is normal
-  UniqueFd wake_fd(::shm_open(wake_name.c_str(), O_RDWR | O_CREAT | O_EXCL | O_CLOEXEC, kWakeMode));
-  if (!wake_fd.valid()) {
+  UniqueFd fd(::shm_open(wake_name.c_str(), O_RDWR | O_CREAT | O_EXCL | O_CLOEXEC, kWakeMode));
+  if (!fd.valid()) {
     const int e = errno;
     return fail(code, shm::errc_from_errno(e),
                 "cannot create shm segment " + wake_name + " (mode " + shm::mode_text(kWakeMode) +
                     "): " + shm::errno_text(e));
   }
-  if (auto r = set_owner_and_mode(wake_fd.get(), wake_name, kWakeMode, *gid, code); !r) {
-    return r.error();
-  }
-  if (::ftruncate(wake_fd.get(), sizeof(WakeSegment)) != 0) {
-    const int e = errno;
-    return fail(code, shm::errc_from_errno(e),
-                "cannot size shm segment " + wake_name + " to " +
-                    std::to_string(sizeof(WakeSegment)) + " bytes: " + shm::errno_text(e));
-  }
-  int map_error = 0;
-  Mapping wake_mapping = shm::map_shared(wake_fd.get(), sizeof(WakeSegment), true, &map_error);
-  if (wake_mapping.get() == nullptr) {
-    return fail(code, shm::errc_from_errno(map_error),
-                "cannot map shm segment " + wake_name + ": " + shm::errno_text(map_error));
-  }
-  const uint64_t generation = new_generation();
-  auto* wake = new (wake_mapping.get()) WakeSegment();
+  if (auto r = set_owner_and_mode(fd.get(), wake_name, kWakeMode, gid, code); !r) return r.error();
+  auto mapping = size_and_map(fd.get(), wake_name, sizeof(WakeSegment), code);
+  if (!mapping) return mapping.error();
+  auto* wake = new (mapping->get()) WakeSegment();
   wake->generation = generation;
   wake->magic.store(shm::kWakeMagic, std::memory_order_release);
+  *fd_out = std::move(fd);
+  *mapping_out = std::move(mapping).value();
+  return {};
+}
 
-  // 3. The pose segment; `magic` last, so a reader that sees it sees the rest.
-  if (::ftruncate(fd.get(), sizeof(Segment)) != 0) {
-    const int e = errno;
-    return fail(code, shm::errc_from_errno(e),
-                "cannot size shm segment " + name + " to " + std::to_string(sizeof(Segment)) +
-                    " bytes: " + shm::errno_text(e));
-  }
-  Mapping mapping = shm::map_shared(fd.get(), sizeof(Segment), true, &map_error);
-  if (mapping.get() == nullptr) {
-    return fail(code, shm::errc_from_errno(map_error),
-                "cannot map shm segment " + name + " (" + std::to_string(sizeof(Segment)) +
-                    " bytes): " + shm::errno_text(map_error));
-  }
-  auto* seg = new (mapping.get()) Segment();
+// Fills the pose segment's header; `magic` last, so a reader that sees it
+// sees the rest.
+Segment* init_pose_segment(void* memory, const ShmOptions& options, uint64_t generation) {
+  auto* seg = new (memory) Segment();
   auto& h = seg->header;
   h.abi_version = shm::kAbiVersion;
   h.header_size = sizeof(shm::SegmentHeader);
@@ -323,13 +313,46 @@ Result<ShmPoseWriter> ShmPoseWriter::create(const ShmOptions& options, ShmErrc* 
   h.heartbeat_mono_ns.store(h.start_mono_ns, std::memory_order_relaxed);
   h.stale_after_ms = static_cast<uint32_t>(std::max(1, options.stale_after_ms));
   h.magic.store(shm::kMagic, std::memory_order_release);
+  return seg;
+}
 
-  impl->fd = std::move(fd);
-  impl->mapping = std::move(mapping);
-  impl->wake_fd = std::move(wake_fd);
-  impl->wake_mapping = std::move(wake_mapping);
-  impl->seg = seg;
-  impl->wake = wake;
+}  // namespace
+
+Result<ShmPoseWriter> ShmPoseWriter::create(const ShmOptions& options, ShmErrc* code) {
+  if (code != nullptr) *code = ShmErrc::kOk;
+  const std::string& name = options.name;
+  if (auto ok = check_options(options, code); !ok) return ok.error();
+  auto gid = lookup_group(options.group, name, code);
+  if (!gid) return gid.error();
+  auto fd = claim_name(name, code);
+  if (!fd) return fd.error();
+
+  // Until the segment is complete, any failure removes what was made.
+  struct Cleanup {
+    const std::string* name;
+    bool armed = true;
+    ~Cleanup() {
+      if (!armed) return;
+      ::shm_unlink(name->c_str());
+      ::shm_unlink(shm::wake_segment_name(*name).c_str());
+    }
+  } cleanup{&name};
+
+  if (auto r = set_owner_and_mode(fd->get(), name, kSegmentMode, *gid, code); !r) return r.error();
+  auto impl = std::make_unique<Impl>();
+  impl->name = name;
+  const uint64_t generation = new_generation();
+  if (auto r =
+          create_wake_segment(name, *gid, generation, &impl->wake_fd, &impl->wake_mapping, code);
+      !r)
+    return r.error();
+  auto mapping = size_and_map(fd->get(), name, sizeof(Segment), code);
+  if (!mapping) return mapping.error();
+
+  impl->seg = init_pose_segment(mapping->get(), options, generation);
+  impl->wake = static_cast<WakeSegment*>(impl->wake_mapping.get());
+  impl->fd = std::move(fd).value();
+  impl->mapping = std::move(mapping).value();
   if (options.heartbeat_period_ms > 0) impl->start_heartbeat_thread(options.heartbeat_period_ms);
   cleanup.armed = false;
   return ShmPoseWriter(std::move(impl));
