@@ -51,11 +51,9 @@ int fail(int code, const std::string& message) {
   return code;
 }
 
-int run_record(const RecordArgs& a) {
-  const bool replay = capture::is_replay_spec(a.source);
-  if (a.frames <= 0 && a.duration_s <= 0.0 && !replay) {
-    return fail(kExitUsage, "a live source needs --frames N or --duration S");
-  }
+// Makes, opens and starts the source --source names; prints why and sets *rc
+// when it cannot.
+std::unique_ptr<capture::FrameSource> start_source(const RecordArgs& a, bool replay, int* rc) {
   capture::SourceOptions options;
   options.width = a.width;
   options.height = a.height;
@@ -68,89 +66,125 @@ int run_record(const RecordArgs& a) {
     generator = std::make_shared<sim::TrajectoryCamera>(camera);
   }
   auto made = capture::make_frame_source(a.source, options, std::move(generator));
-  if (!made) return fail(kExitUsage, made.error().message);
-  capture::FrameSource& source = **made;
-  if (auto r = source.open(); !r)
-    return fail(replay ? kExitBadInput : kExitFailure, r.error().message);
-  if (auto r = source.start(); !r) return fail(kExitFailure, r.error().message);
-  std::fprintf(stderr, "record: %s -> %s\n", source.describe().c_str(), a.out_dir.c_str());
+  if (!made) {
+    *rc = fail(kExitUsage, made.error().message);
+    return nullptr;
+  }
+  std::unique_ptr<capture::FrameSource> source = std::move(made).value();
+  if (auto r = source->open(); !r) {
+    *rc = fail(replay ? kExitBadInput : kExitFailure, r.error().message);
+    return nullptr;
+  }
+  if (auto r = source->start(); !r) {
+    *rc = fail(kExitFailure, r.error().message);
+    return nullptr;
+  }
+  return source;
+}
 
-  std::optional<RecordingWriter> writer;
+// Writes the frames of one source to --out: the writer is created at the
+// first frame (a driver may adjust the size), YUYV is converted to RGB.
+class FrameRecorder {
+ public:
+  FrameRecorder(const RecordArgs& a, const capture::FrameSource& source) : a_(a), source_(source) {}
+
+  // kExitOk, or the exit code after printing why.
+  int write(const capture::Frame& frame) {
+    if (!writer_) {
+      RecordingCamera camera;
+      if (source_.camera_intrinsics(&camera.intrinsics)) {
+        camera.source = source_.describe();
+      } else {
+        camera.intrinsics = scaled_default(frame.image.width, frame.image.height);
+        camera.source = source_.describe() + "; uncalibrated: SPEC default intrinsics scaled";
+      }
+      auto w = RecordingWriter::create(a_.out_dir, camera);
+      if (!w) return fail(kExitFailure, w.error().message);
+      writer_.emplace(std::move(w).value());
+    }
+    ImageView view = frame.image;
+    if (view.format == PixelFormat::kYuyv) {
+      if (auto r = capture::to_rgb24(view, &converted_); !r)
+        return fail(kExitFailure, r.error().message);
+      view = converted_.view();
+    }
+    auto r =
+        writer_->append(view, frame.source_timestamp_ns,
+                        frame.has_ground_truth ? &frame.ground_truth : nullptr, a_.jpeg_quality);
+    if (!r) return fail(kExitFailure, r.error().message);
+    ++written_;
+    return kExitOk;
+  }
+
+  // Closes the recording; `rc` unless closing fails.
+  int close(int rc) {
+    if (writer_) {
+      if (auto r = writer_->close(); !r && rc == kExitOk)
+        rc = fail(kExitFailure, r.error().message);
+    }
+    return rc;
+  }
+
+  int64_t written() const { return written_; }
+
+ private:
+  const RecordArgs& a_;
+  const capture::FrameSource& source_;
+  std::optional<RecordingWriter> writer_;
+  Image converted_;
+  int64_t written_ = 0;
+};
+
+int run_record(const RecordArgs& a) {
+  const bool replay = capture::is_replay_spec(a.source);
+  if (a.frames <= 0 && a.duration_s <= 0.0 && !replay) {
+    return fail(kExitUsage, "a live source needs --frames N or --duration S");
+  }
+  int rc = kExitOk;
+  std::unique_ptr<capture::FrameSource> source = start_source(a, replay, &rc);
+  if (!source) return rc;
+  std::fprintf(stderr, "record: %s -> %s\n", source->describe().c_str(), a.out_dir.c_str());
+
+  FrameRecorder recorder(a, *source);
   capture::Frame frame;
-  Image converted;
-  int64_t written = 0;
   const int64_t start_ns = monotonic_ns();
   const int64_t end_ns =
       a.duration_s > 0.0 ? start_ns + static_cast<int64_t>(std::llround(a.duration_s * 1e9)) : 0;
   int64_t next_progress_ns = start_ns + 1'000'000'000;
   bool progress_shown = false;
-  int rc = kExitOk;
-  for (;;) {
-    if (a.frames > 0 && written >= a.frames) break;
+  while (rc == kExitOk) {
+    if (a.frames > 0 && recorder.written() >= a.frames) break;
     if (end_ns != 0 && monotonic_ns() >= end_ns) break;
-    const capture::NextStatus s = source.next(&frame, 100);
+    const capture::NextStatus s = source->next(&frame, 100);
     if (s == capture::NextStatus::kEndOfStream) break;
     if (s == capture::NextStatus::kError) {
-      rc = fail(replay ? kExitBadInput : kExitFailure, source.describe() + ": source failed");
+      rc = fail(replay ? kExitBadInput : kExitFailure, source->describe() + ": source failed");
       break;
     }
     if (s == capture::NextStatus::kTimeout) continue;
-    if (!writer) {
-      // The size is known only from the first frame (a driver may adjust it).
-      RecordingCamera camera;
-      if (source.camera_intrinsics(&camera.intrinsics)) {
-        camera.source = source.describe();
-      } else {
-        camera.intrinsics = scaled_default(frame.image.width, frame.image.height);
-        camera.source = source.describe() + "; uncalibrated: SPEC default intrinsics scaled";
-      }
-      auto w = RecordingWriter::create(a.out_dir, camera);
-      if (!w) {
-        source.release(frame);
-        rc = fail(kExitFailure, w.error().message);
-        break;
-      }
-      writer.emplace(std::move(w).value());
-    }
-    ImageView view = frame.image;
-    if (view.format == PixelFormat::kYuyv) {
-      if (auto r = capture::to_rgb24(view, &converted); !r) {
-        source.release(frame);
-        rc = fail(kExitFailure, r.error().message);
-        break;
-      }
-      view = converted.view();
-    }
-    auto r = writer->append(view, frame.source_timestamp_ns,
-                            frame.has_ground_truth ? &frame.ground_truth : nullptr, a.jpeg_quality);
-    source.release(frame);
-    if (!r) {
-      rc = fail(kExitFailure, r.error().message);
-      break;
-    }
-    ++written;
+    rc = recorder.write(frame);
+    source->release(frame);
     const int64_t now_ns = monotonic_ns();
     if (now_ns >= next_progress_ns) {
-      const auto st = source.stats();
+      const auto st = source->stats();
       std::fprintf(stderr, "record: %lld frames, %.1f fps, %llu dropped, %llu outages\r",
-                   static_cast<long long>(written), written * 1e9 / (now_ns - start_ns),
+                   static_cast<long long>(recorder.written()),
+                   recorder.written() * 1e9 / (now_ns - start_ns),
                    static_cast<unsigned long long>(st.drops),
                    static_cast<unsigned long long>(st.outages));
       next_progress_ns = now_ns + 1'000'000'000;
       progress_shown = true;
     }
   }
-  source.stop();
-  if (writer) {
-    if (auto r = writer->close(); !r && rc == kExitOk) rc = fail(kExitFailure, r.error().message);
-  }
-  const auto st = source.stats();
+  source->stop();
+  rc = recorder.close(rc);
+  const auto st = source->stats();
   if (progress_shown) std::fputc('\n', stderr);  // end the \r progress line
   std::fprintf(stderr, "record: %lld frames written to %s; %llu dropped, %llu outages\n",
-               static_cast<long long>(written), a.out_dir.c_str(),
+               static_cast<long long>(recorder.written()), a.out_dir.c_str(),
                static_cast<unsigned long long>(st.drops),
                static_cast<unsigned long long>(st.outages));
-  if (rc == kExitOk && written == 0) rc = fail(kExitFailure, "no frame was captured");
+  if (rc == kExitOk && recorder.written() == 0) rc = fail(kExitFailure, "no frame was captured");
   return rc;
 }
 

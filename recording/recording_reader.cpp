@@ -285,6 +285,72 @@ Result<std::string> read_text(const std::string& path, const char* what) {
   return ss.str();
 }
 
+// One data row of frames.csv, checked against the row before it (`previous`,
+// null for the first): index in sequence, timestamp not going backwards, a
+// relative file name, ground truth all three or none.
+Result<RecordingRow> parse_row(const std::vector<std::string>& fields, const Columns& cols,
+                               bool ground_truth_columns, const RecordingRow* previous,
+                               int64_t expected_index, int line_no, const std::string& where) {
+  if (fields.size() != cols.count) {
+    return make_error(where + ": " + std::to_string(fields.size()) + " fields, the header has " +
+                      std::to_string(cols.count));
+  }
+  RecordingRow row;
+  row.csv_line = line_no;
+  if (!parse_int64(fields[cols.index], &row.index)) {
+    return make_error(where + ": index " + quoted(fields[cols.index]) + " is not an integer");
+  }
+  if (row.index != expected_index) {
+    return make_error(where + ": index " + std::to_string(row.index) +
+                      " out of sequence (expected " + std::to_string(expected_index) +
+                      "; indices count from 0 without gaps)");
+  }
+  if (!parse_int64(fields[cols.timestamp], &row.timestamp_ns)) {
+    return make_error(where + ": timestamp_ns " + quoted(fields[cols.timestamp]) +
+                      " is not an integer");
+  }
+  if (previous != nullptr && row.timestamp_ns < previous->timestamp_ns) {
+    return make_error(where + ": timestamp_ns " + std::to_string(row.timestamp_ns) +
+                      " goes backwards (previous " + std::to_string(previous->timestamp_ns) + ")");
+  }
+  row.file = fields[cols.file];
+  if (row.file.empty()) return make_error(where + ": empty file name");
+  if (row.file.front() == '/') {
+    return make_error(where + ": file " + quoted(row.file) +
+                      " must be relative to the recording directory");
+  }
+  if (!ground_truth_columns) return row;
+  const std::string& gx = fields[cols.gt_x];
+  const std::string& gy = fields[cols.gt_y];
+  const std::string& gyaw = fields[cols.gt_yaw];
+  // All three empty: this frame has no ground truth (e.g. a tracker lost it).
+  if (gx.empty() && gy.empty() && gyaw.empty()) return row;
+  for (auto [name, text, dst] : {std::tuple{"gt_x_m", &gx, &row.ground_truth.x_m},
+                                 std::tuple{"gt_y_m", &gy, &row.ground_truth.y_m},
+                                 std::tuple{"gt_yaw_rad", &gyaw, &row.ground_truth.yaw_rad}}) {
+    if (!parse_double(*text, dst)) {
+      return make_error(where + ": " + name + " " + quoted(*text) + " is not a finite number");
+    }
+  }
+  row.has_ground_truth = true;
+  return row;
+}
+
+// The frame file a row names must exist and be a regular file (a FIFO or a
+// directory would hang or fail the decoder later).
+Result<void> check_frame_file(const std::string& frame_path, int line_no) {
+  struct stat fst {};
+  if (::stat(frame_path.c_str(), &fst) != 0) {
+    return make_error(frame_path + " (frames.csv:" + std::to_string(line_no) +
+                      "): frame file missing (" + std::strerror(errno) + ")");
+  }
+  if (!S_ISREG(fst.st_mode)) {
+    return make_error(frame_path + " (frames.csv:" + std::to_string(line_no) +
+                      "): not a regular file");
+  }
+  return {};
+}
+
 }  // namespace
 
 RecordingReader::RecordingReader() : scratch_(make_decode_buffers()) {}
@@ -343,65 +409,13 @@ Result<RecordingReader> RecordingReader::open(const std::string& dir) {
       r.has_ground_truth_columns_ = cols.gt_x >= 0;
       continue;
     }
-    if (fields.size() != cols.count) {
-      return make_error(where + ": " + std::to_string(fields.size()) + " fields, the header has " +
-                        std::to_string(cols.count));
-    }
-    RecordingRow row;
-    row.csv_line = line_no;
-    if (!parse_int64(fields[cols.index], &row.index)) {
-      return make_error(where + ": index " + quoted(fields[cols.index]) + " is not an integer");
-    }
-    const int64_t expected_index = static_cast<int64_t>(r.rows_.size());
-    if (row.index != expected_index) {
-      return make_error(where + ": index " + std::to_string(row.index) +
-                        " out of sequence (expected " + std::to_string(expected_index) +
-                        "; indices count from 0 without gaps)");
-    }
-    if (!parse_int64(fields[cols.timestamp], &row.timestamp_ns)) {
-      return make_error(where + ": timestamp_ns " + quoted(fields[cols.timestamp]) +
-                        " is not an integer");
-    }
-    if (!r.rows_.empty() && row.timestamp_ns < r.rows_.back().timestamp_ns) {
-      return make_error(where + ": timestamp_ns " + std::to_string(row.timestamp_ns) +
-                        " goes backwards (previous " + std::to_string(r.rows_.back().timestamp_ns) +
-                        ")");
-    }
-    row.file = fields[cols.file];
-    if (row.file.empty()) return make_error(where + ": empty file name");
-    if (row.file.front() == '/') {
-      return make_error(where + ": file " + quoted(row.file) +
-                        " must be relative to the recording directory");
-    }
-    if (r.has_ground_truth_columns_) {
-      const std::string& gx = fields[cols.gt_x];
-      const std::string& gy = fields[cols.gt_y];
-      const std::string& gyaw = fields[cols.gt_yaw];
-      // All three empty: this frame has no ground truth (e.g. a tracker lost it).
-      if (!(gx.empty() && gy.empty() && gyaw.empty())) {
-        for (auto [name, text, dst] :
-             {std::tuple{"gt_x_m", &gx, &row.ground_truth.x_m},
-              std::tuple{"gt_y_m", &gy, &row.ground_truth.y_m},
-              std::tuple{"gt_yaw_rad", &gyaw, &row.ground_truth.yaw_rad}}) {
-          if (!parse_double(*text, dst)) {
-            return make_error(where + ": " + name + " " + quoted(*text) +
-                              " is not a finite number");
-          }
-        }
-        row.has_ground_truth = true;
-      }
-    }
-    const std::string frame_path = r.dir_ + "/" + row.file;
-    struct stat fst {};
-    if (::stat(frame_path.c_str(), &fst) != 0) {
-      return make_error(frame_path + " (frames.csv:" + std::to_string(line_no) +
-                        "): frame file missing (" + std::strerror(errno) + ")");
-    }
-    if (!S_ISREG(fst.st_mode)) {
-      return make_error(frame_path + " (frames.csv:" + std::to_string(line_no) +
-                        "): not a regular file");
-    }
-    r.rows_.push_back(std::move(row));
+    auto row = parse_row(fields, cols, r.has_ground_truth_columns_,
+                         r.rows_.empty() ? nullptr : &r.rows_.back(),
+                         static_cast<int64_t>(r.rows_.size()), line_no, where);
+    if (!row) return row.error();
+    const std::string frame_path = r.dir_ + "/" + row->file;
+    if (auto ok = check_frame_file(frame_path, line_no); !ok) return ok.error();
+    r.rows_.push_back(std::move(row).value());
     r.frame_paths_.push_back(frame_path);
   }
   if (!header_seen) return make_error(csv_path + ":1: empty file, expected the header line");
