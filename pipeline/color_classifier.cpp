@@ -153,51 +153,54 @@ void ColorClassifier::use_default_normalisation() {
   set_gains({1.0f, 1.0f, 1.0f});
 }
 
-bool ColorClassifier::adapt(const ImageView& frame) {
-  if (frame.empty() || frame.format == PixelFormat::kMjpeg) {
-    use_default_normalisation();
-    return false;
-  }
-  // The grid's tile candidates are kept (packed) for the two later passes;
-  // frames with more grid points than the buffer holds (above ≈ 1920 × 1080
-  // at step 16) are sampled more coarsely.
+// 1. A grid of samples (coarser when the frame has more grid points than the
+// buffer holds, above about 1920 x 1080 at step 16); the bright, unsaturated
+// ones are tile candidates, kept packed for the later passes, with a
+// histogram of their levels.
+uint32_t ColorClassifier::sample_candidates(const ImageView& frame,
+                                            std::array<uint32_t, 256>* level_count,
+                                            uint32_t* total) {
   int step = std::max(1, params_.white_sample_step_px);
   while (static_cast<size_t>((frame.width + step - 1) / step) * ((frame.height + step - 1) / step) >
          samples_.size())
     ++step;
-  std::array<uint32_t, 256> count{};
-  uint32_t total = 0, candidates = 0;
+  uint32_t candidates = 0;
+  *total = 0;
   for (int y = step / 2; y < frame.height; y += step)
     for (int x = step / 2; x < frame.width; x += step) {
       uint8_t r = 0, g = 0, b = 0;
       read_rgb(frame, x, y, &r, &g, &b);
-      ++total;
+      ++*total;
       const int v = std::max({r, g, b});
       const int m = std::min({r, g, b});
       // Saturation (v - m) / v at most kMaxTileSaturationNum / Den.
       if (v < kMinSampleLevel || (v - m) * kMaxTileSaturationDen > v * kMaxTileSaturationNum)
         continue;
-      ++count[(r + g + b) / 3];
+      ++(*level_count)[(r + g + b) / 3];
       samples_[candidates++] =
           static_cast<uint32_t>(r) | static_cast<uint32_t>(g) << 8 | static_cast<uint32_t>(b) << 16;
     }
-  if (total == 0 || static_cast<float>(candidates) < params_.white_min_share * total) {
-    use_default_normalisation();
-    return false;
-  }
-  const int median = median_bin(count, candidates);
-  const int lo_sum = 3 * static_cast<int>(std::floor(median * (1.0f - kTileWindow)));
-  const int hi_sum = 3 * static_cast<int>(std::ceil(median * (1.0f + kTileWindow))) + 2;
-  // Visits the candidates within the tile's brightness window with their
-  // chromaticities c / (r + g + b) in 1/255 steps (r and b fix g).
+  return candidates;
+}
+
+// 2. Of the candidates within the brightness window around the median level,
+// those within the chromaticity window around the median chromaticity: the
+// tile, robust to strong casts and to coloured clutter. Their summed colour
+// in *sum; returns how many.
+uint32_t ColorClassifier::tile_colour_sum(uint32_t candidates, int median_level,
+                                          std::array<double, 3>* sum) const {
+  const int lo_sum = 3 * static_cast<int>(std::floor(median_level * (1.0f - kTileWindow)));
+  const int hi_sum = 3 * static_cast<int>(std::ceil(median_level * (1.0f + kTileWindow))) + 2;
+  // Visits the candidates within the window with their chromaticities
+  // c / (r + g + b) in 1/255 steps (r and b fix g).
   const auto for_each_windowed = [&](auto&& visit) {
     for (uint32_t k = 0; k < candidates; ++k) {
       const int r = static_cast<int>(samples_[k] & 0xff);
       const int g = static_cast<int>(samples_[k] >> 8 & 0xff);
       const int b = static_cast<int>(samples_[k] >> 16);
-      const int sum = r + g + b;
-      if (sum < lo_sum || sum > hi_sum) continue;
-      const uint32_t scale = chroma_scale_[sum];
+      const int level_sum = r + g + b;
+      if (level_sum < lo_sum || level_sum > hi_sum) continue;
+      const uint32_t scale = chroma_scale_[level_sum];
       visit(r, g, b, static_cast<int>((static_cast<uint32_t>(r) * scale) >> 16),
             static_cast<int>((static_cast<uint32_t>(b) * scale) >> 16));
     }
@@ -211,26 +214,43 @@ bool ColorClassifier::adapt(const ImageView& frame) {
   });
   const int median_r = median_bin(chroma_count[0], windowed);
   const int median_b = median_bin(chroma_count[1], windowed);
-  std::array<double, 3> acc{};
   uint32_t n = 0;
   for_each_windowed([&](int r, int g, int b, int chroma_r, int chroma_b) {
     if (std::abs(chroma_r - median_r) > kTileChromaWindow ||
         std::abs(chroma_b - median_b) > kTileChromaWindow)
       return;
-    acc[0] += r;
-    acc[1] += g;
-    acc[2] += b;
+    (*sum)[0] += r;
+    (*sum)[1] += g;
+    (*sum)[2] += b;
     ++n;
   });
+  return n;
+}
+
+bool ColorClassifier::adapt(const ImageView& frame) {
+  if (frame.empty() || frame.format == PixelFormat::kMjpeg) {
+    use_default_normalisation();
+    return false;
+  }
+  std::array<uint32_t, 256> level_count{};
+  uint32_t total = 0;
+  const uint32_t candidates = sample_candidates(frame, &level_count, &total);
+  if (total == 0 || static_cast<float>(candidates) < params_.white_min_share * total) {
+    use_default_normalisation();
+    return false;
+  }
+  std::array<double, 3> sum{};
+  const uint32_t n = tile_colour_sum(candidates, median_bin(level_count, candidates), &sum);
   if (n == 0 || static_cast<float>(n) < params_.white_min_share * total) {
     use_default_normalisation();
     return false;
   }
+  // 3. Gains that take the measured tile to its nominal colour.
   const std::array<float, 3> nominal{static_cast<float>(tile_.r), static_cast<float>(tile_.g),
                                      static_cast<float>(tile_.b)};
   std::array<float, 3> gains{};
   for (int c = 0; c < 3; ++c) {
-    reference_[c] = static_cast<float>(acc[c] / n);
+    reference_[c] = static_cast<float>(sum[c] / n);
     gains[c] = std::clamp(nominal[c] / std::max(1.0f, reference_[c]), kMinGain, kMaxGain);
   }
   set_gains(gains);

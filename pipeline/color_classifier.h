@@ -89,6 +89,9 @@ class ColorClassifier {
 
  private:
   void use_default_normalisation();
+  uint32_t sample_candidates(const ImageView& frame, std::array<uint32_t, 256>* level_count,
+                             uint32_t* total);
+  uint32_t tile_colour_sum(uint32_t candidates, int median_level, std::array<double, 3>* sum) const;
 
   DetectorParams params_;
   Rgb tile_{};

@@ -85,28 +85,12 @@ PoseEstimate TemporalFilter::output(const PoseEstimate* used) const {
   return out;
 }
 
-PoseEstimate TemporalFilter::update(const PoseEstimate& m, int64_t timestamp_ns) {
-  const double timeout_ns = params_.predict_timeout_ms * 1e6;
-  if (initialised_ && static_cast<double>(timestamp_ns - last_measurement_ns_) > timeout_ns) {
-    initialised_ = false;
-    ++stats_.timeouts;
-  }
-  if (!initialised_) {
-    if (!m.valid) return PoseEstimate{};
-    initialise(m, timestamp_ns);
-    ++stats_.updates;
-    return output(&m);
-  }
-  predict(std::max<int64_t>(0, timestamp_ns - last_ns_) * 1e-9);
-  last_ns_ = std::max(last_ns_, timestamp_ns);
-  if (!m.valid) {
-    ++stats_.predictions;
-    return output(nullptr);
-  }
-
-  // Innovation y = z − H·x (yaw wrapped), S = P₃₃ + R.
-  const double y[3] = {m.pose.x_m - state_[0], m.pose.y_m - state_[1],
-                       wrap_angle_rad(m.pose.yaw_rad - state_[2])};
+// Innovation y = z - H x (yaw wrapped) and the inverse of its covariance
+// S = P33 + R, R being the measurement's covariance with the floors applied.
+// False when S is singular.
+bool TemporalFilter::innovation(const PoseEstimate& m, std::array<double, 3>* y,
+                                std::array<double, 9>* s_inv) const {
+  *y = {m.pose.x_m - state_[0], m.pose.y_m - state_[1], wrap_angle_rad(m.pose.yaw_rad - state_[2])};
   std::array<double, 9> r = m.covariance;
   const double floor_m2 = params_.meas_sigma_floor_m * params_.meas_sigma_floor_m;
   const double floor_rad2 = params_.meas_sigma_floor_yaw_rad * params_.meas_sigma_floor_yaw_rad;
@@ -116,30 +100,23 @@ PoseEstimate TemporalFilter::update(const PoseEstimate& m, int64_t timestamp_ns)
   std::array<double, 9> s{};
   for (int i = 0; i < 3; ++i)
     for (int j = 0; j < 3; ++j) s[i * 3 + j] = cov_[i * kN + j] + r[i * 3 + j];
-  std::array<double, 9> s_inv{};
-  if (!invert3(s, &s_inv)) {
-    ++stats_.predictions;
-    return output(nullptr);
-  }
+  return invert3(s, s_inv);
+}
+
+// Whether the innovation is a jump to refuse: beyond the chi-square gate and
+// not within the small-innovation allowance.
+bool TemporalFilter::gated(const std::array<double, 3>& y,
+                           const std::array<double, 9>& s_inv) const {
   double d2 = 0.0;
   for (int i = 0; i < 3; ++i)
     for (int j = 0; j < 3; ++j) d2 += y[i] * s_inv[i * 3 + j] * y[j];
   const bool small =
       std::hypot(y[0], y[1]) <= params_.gate_min_m && std::abs(y[2]) <= params_.gate_min_rad;
-  if (d2 > params_.gate_chi2 && !small) {
-    ++stats_.gated;
-    if (++consecutive_gated_ >= params_.reinit_after_gated) {
-      // The measurements have agreed with each other, not with us, for long
-      // enough: the robot was moved or the filter diverged.
-      ++stats_.reinitialisations;
-      initialise(m, timestamp_ns);
-      return output(&m);
-    }
-    ++stats_.predictions;
-    return output(nullptr);
-  }
+  return d2 > params_.gate_chi2 && !small;
+}
 
-  // K = P Hᵀ S⁻¹ (6x3); x += K y; P −= K H P.
+// K = P H^T S^-1 (6x3); x += K y; P -= K H P, kept symmetric.
+void TemporalFilter::correct(const std::array<double, 3>& y, const std::array<double, 9>& s_inv) {
   std::array<double, kN * 3> k{};
   for (int i = 0; i < kN; ++i)
     for (int j = 0; j < 3; ++j) {
@@ -157,10 +134,45 @@ PoseEstimate TemporalFilter::update(const PoseEstimate& m, int64_t timestamp_ns)
       for (int j = 0; j < 3; ++j) sum += k[i * 3 + j] * cov_[j * kN + c];
       p[i * kN + c] -= sum;
     }
-  for (int i = 0; i < kN; ++i)  // keep P symmetric against round-off
+  for (int i = 0; i < kN; ++i)  // against round-off
     for (int c = i + 1; c < kN; ++c)
       p[i * kN + c] = p[c * kN + i] = 0.5 * (p[i * kN + c] + p[c * kN + i]);
   cov_ = p;
+}
+
+PoseEstimate TemporalFilter::update(const PoseEstimate& m, int64_t timestamp_ns) {
+  const double timeout_ns = params_.predict_timeout_ms * 1e6;
+  if (initialised_ && static_cast<double>(timestamp_ns - last_measurement_ns_) > timeout_ns) {
+    initialised_ = false;
+    ++stats_.timeouts;
+  }
+  if (!initialised_) {
+    if (!m.valid) return PoseEstimate{};
+    initialise(m, timestamp_ns);
+    ++stats_.updates;
+    return output(&m);
+  }
+  predict(std::max<int64_t>(0, timestamp_ns - last_ns_) * 1e-9);
+  last_ns_ = std::max(last_ns_, timestamp_ns);
+  std::array<double, 3> y{};
+  std::array<double, 9> s_inv{};
+  if (!m.valid || !innovation(m, &y, &s_inv)) {
+    ++stats_.predictions;
+    return output(nullptr);
+  }
+  if (gated(y, s_inv)) {
+    ++stats_.gated;
+    if (++consecutive_gated_ >= params_.reinit_after_gated) {
+      // The measurements have agreed with each other, not with us, for long
+      // enough: the robot was moved or the filter diverged.
+      ++stats_.reinitialisations;
+      initialise(m, timestamp_ns);
+      return output(&m);
+    }
+    ++stats_.predictions;
+    return output(nullptr);
+  }
+  correct(y, s_inv);
   consecutive_gated_ = 0;
   last_measurement_ns_ = timestamp_ns;
   last_mode_ = m.mode;

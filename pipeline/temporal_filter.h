@@ -37,6 +37,10 @@ class TemporalFilter {
   static constexpr int kN = 6;  // x, y, yaw, vx, vy, vyaw
   void initialise(const PoseEstimate& measurement, int64_t timestamp_ns);
   void predict(double dt_s);
+  bool innovation(const PoseEstimate& m, std::array<double, 3>* y,
+                  std::array<double, 9>* s_inv) const;
+  bool gated(const std::array<double, 3>& y, const std::array<double, 9>& s_inv) const;
+  void correct(const std::array<double, 3>& y, const std::array<double, 9>& s_inv);
   PoseEstimate output(const PoseEstimate* used) const;
 
   FilterParams params_;
