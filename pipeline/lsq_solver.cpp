@@ -258,12 +258,14 @@ double LsqSolver::optimise(const ViewGeometry& view, const PositioningParams& pa
   return cost;
 }
 
-bool LsqSolver::solve(const ViewGeometry& view, const PositioningParams& params,
-                      std::span<const MarkerObservation> markers, std::span<const MarkerFix> fixes,
-                      std::span<bool> use, LsqResult* out) {
+// 1. Correspondences of the markers in use (a marker without measured points
+// still gives its centre and its two rectangle centres), and the seed: the
+// Change of Axes answers averaged, nominal tilt and height. Returns the
+// markers used.
+int LsqSolver::gather_points(const ViewGeometry& view, std::span<const MarkerObservation> markers,
+                             std::span<const MarkerFix> fixes, std::span<const bool> use,
+                             State* seed) {
   const CeilingLayout& layout = view.layout();
-  // 1. Correspondences of the markers in use; a marker without measured
-  // points still gives its centre and its two rectangle centres.
   point_count_ = 0;
   int marker_count = 0;
   double sin_sum = 0.0, cos_sum = 0.0, x_sum = 0.0, y_sum = 0.0;
@@ -297,75 +299,77 @@ bool LsqSolver::solve(const ViewGeometry& view, const PositioningParams& params,
     x_sum += fix.cam_x_m;
     y_sum += fix.cam_y_m;
   }
-  if (marker_count == 0 || point_count_ < params.lsq_min_points) return false;
+  if (marker_count > 0) {
+    seed->t_w = {x_sum / marker_count, y_sum / marker_count, view.mount().lens_height_m};
+    seed->r_wc = mat_mul(level_rotation(std::atan2(sin_sum, cos_sum)), view.tilt());
+  }
+  return marker_count;
+}
 
-  // 2. Seed: the Change of Axes answers averaged, nominal tilt and height.
-  State st;
-  st.t_w = {x_sum / marker_count, y_sum / marker_count, view.mount().lens_height_m};
-  st.r_wc = mat_mul(level_rotation(std::atan2(sin_sum, cos_sum)), view.tilt());
+// 2. Free tilt first (robust to a real tilt's large residuals, and it rejects
+// outlier markers), then the same markers with the tilt held at nominal. The
+// held model wins unless freeing the tilt explains the points significantly
+// better: tilt trades off against translation so closely that estimating it
+// costs ~10x the position noise of holding it, and a tilt too small to be
+// detected is also too small to matter. Returns the cost (not finite: no
+// solution); *tilt_estimated says which model won.
+double LsqSolver::fit(const ViewGeometry& view, const PositioningParams& params,
+                      std::span<const MarkerFix> fixes, std::span<bool> use, State* st,
+                      int* marker_count, int* iterations, bool* tilt_estimated) {
   active_ = {true, true, true, false, false, params.lsq_estimate_height};
-
-  // 3. Free tilt first (robust to a real tilt's large residuals, and it
-  // rejects outlier markers), then the same markers with the tilt held at
-  // nominal. The held model wins unless freeing the tilt explains the points
-  // significantly better: tilt trades off against translation so closely
-  // that estimating it costs ~10x the position noise of holding it, and a
-  // tilt too small to be detected is also too small to matter.
-  const bool tilt_allowed = params.lsq_estimate_tilt && marker_count >= params.lsq_tilt_min_markers;
+  const bool tilt_allowed =
+      params.lsq_estimate_tilt && *marker_count >= params.lsq_tilt_min_markers;
   active_[kTiltX] = active_[kTiltY] = tilt_allowed;
-  int iterations = 0;
-  double cost = optimise(view, params, use, fixes, true, &st, &marker_count, &iterations);
-  if (!std::isfinite(cost)) return false;
-  bool tilt_estimated = tilt_allowed && marker_count >= params.lsq_tilt_min_markers;
-  if (tilt_estimated) {
-    Normal a{};
-    Vector b{};
-    double wr2 = 0.0;
-    int n = 0;
-    accumulate(view, params, use, st, false, &a, &b, &wr2, &n);
-    int p_free = 0;
-    for (bool act : active_) p_free += act ? 1 : 0;
-    const double sigma2 = cost / std::max(1, 2 * n - p_free);
-    State held = st;
-    held.r_wc = mat_mul(level_rotation(camera_yaw(st.r_wc)), view.tilt());
+  double cost = optimise(view, params, use, fixes, true, st, marker_count, iterations);
+  *tilt_estimated = false;
+  if (!std::isfinite(cost)) return cost;
+  if (!tilt_allowed || *marker_count < params.lsq_tilt_min_markers) {
     active_[kTiltX] = active_[kTiltY] = false;
-    const double held_cost =
-        optimise(view, params, use, fixes, false, &held, &marker_count, &iterations);
-    if (std::isfinite(held_cost) && held_cost - cost <= params.lsq_tilt_select_chi2 * sigma2) {
-      st = held;
-      cost = held_cost;
-      tilt_estimated = false;
-    } else {
-      active_[kTiltX] = active_[kTiltY] = true;
-    }
-  } else {
-    active_[kTiltX] = active_[kTiltY] = false;
+    return cost;
   }
   Normal a{};
   Vector b{};
   double wr2 = 0.0;
   int n = 0;
-  accumulate(view, params, use, st, true, &a, &b, &wr2, &n);
-  prior_cost(view, params, st, &a, &b);
-
-  // 4. Accept only a solution that explains the points.
-  double sum_r2 = 0.0;
-  {
-    const Mat3 rt = mat_transpose(st.r_wc);
-    for (int i = 0; i < point_count_; ++i) {
-      const Point& pt = points_[i];
-      if (!use[pt.fix]) continue;
-      sum_r2 += residual2_px(view, rt, st.t_w, pt);
-    }
+  accumulate(view, params, use, *st, false, &a, &b, &wr2, &n);
+  int p_free = 0;
+  for (bool act : active_) p_free += act ? 1 : 0;
+  const double sigma2 = cost / std::max(1, 2 * n - p_free);
+  State held = *st;
+  held.r_wc = mat_mul(level_rotation(camera_yaw(st->r_wc)), view.tilt());
+  active_[kTiltX] = active_[kTiltY] = false;
+  const double held_cost =
+      optimise(view, params, use, fixes, false, &held, marker_count, iterations);
+  if (std::isfinite(held_cost) && held_cost - cost <= params.lsq_tilt_select_chi2 * sigma2) {
+    *st = held;
+    return held_cost;
   }
-  if (n < params.lsq_min_points) return false;
-  const double rms = std::sqrt(sum_r2 / n);
-  if (!(rms <= params.lsq_max_rms_px)) return false;
+  active_[kTiltX] = active_[kTiltY] = true;
+  *tilt_estimated = true;
+  return cost;
+}
 
-  // 5. Covariance: σ²·(JᵀWJ)⁻¹ with σ² = Σw·r²/(m − p) (m residual
-  // components, p parameters), marginalised to (t_x, t_y, ψ) by taking that
-  // block of the inverse, then carried to the robot's (x, y, yaw) through the
-  // mount offset: x = tx − (f·cos yaw − l·sin yaw), y = ty − (f·sin yaw + l·cos yaw).
+// 3. RMS reprojection residual of the points in use, pixels.
+double LsqSolver::rms_px(const ViewGeometry& view, std::span<const bool> use, const State& st,
+                         int n) const {
+  double sum_r2 = 0.0;
+  const Mat3 rt = mat_transpose(st.r_wc);
+  for (int i = 0; i < point_count_; ++i) {
+    const Point& pt = points_[i];
+    if (!use[pt.fix]) continue;
+    sum_r2 += residual2_px(view, rt, st.t_w, pt);
+  }
+  return std::sqrt(sum_r2 / n);
+}
+
+// 4. Covariance: sigma^2 (J^T W J)^-1 with sigma^2 = sum w r^2 / (m - p) (m
+// residual components, p parameters), marginalised to (t_x, t_y, psi) by
+// taking that block of the inverse, then carried to the robot's (x, y, yaw)
+// through the mount offset: x = tx - (f cos yaw - l sin yaw),
+// y = ty - (f sin yaw + l cos yaw); plus the configured floors.
+bool LsqSolver::robot_covariance(const ViewGeometry& view, const PositioningParams& params,
+                                 const Normal& a, double wr2, int n, const Pose2D& robot,
+                                 std::array<double, 9>* out) const {
   int p_count = 0;
   for (bool act : active_) p_count += act ? 1 : 0;
   const double dof = std::max(1, 2 * n - p_count);
@@ -378,9 +382,7 @@ bool LsqSolver::solve(const ViewGeometry& view, const PositioningParams& params,
     if (!solve_spd(a, active_, e, &col)) return false;
     for (int r = 0; r < 3; ++r) inv_cols[r * 3 + c] = sigma2 * col[r];
   }
-  const double psi = camera_yaw(st.r_wc);
-  out->robot = view.robot_from_camera(st.t_w[0], st.t_w[1], psi);
-  const double cy = std::cos(out->robot.yaw_rad), sy = std::sin(out->robot.yaw_rad);
+  const double cy = std::cos(robot.yaw_rad), sy = std::sin(robot.yaw_rad);
   const double fwd = view.mount().offset_forward_m, left = view.mount().offset_left_m;
   const double j[9] = {1.0, 0.0, fwd * sy + left * cy, 0.0, 1.0, -(fwd * cy - left * sy), 0.0,
                        0.0, 1.0};
@@ -389,11 +391,39 @@ bool LsqSolver::solve(const ViewGeometry& view, const PositioningParams& params,
       double s = 0.0;
       for (int k1 = 0; k1 < 3; ++k1)
         for (int k2 = 0; k2 < 3; ++k2) s += j[r * 3 + k1] * inv_cols[k1 * 3 + k2] * j[c * 3 + k2];
-      out->covariance[r * 3 + c] = s;
+      (*out)[r * 3 + c] = s;
     }
-  out->covariance[0] += params.lsq_sigma_floor_m * params.lsq_sigma_floor_m;
-  out->covariance[4] += params.lsq_sigma_floor_m * params.lsq_sigma_floor_m;
-  out->covariance[8] += params.lsq_sigma_floor_yaw_rad * params.lsq_sigma_floor_yaw_rad;
+  (*out)[0] += params.lsq_sigma_floor_m * params.lsq_sigma_floor_m;
+  (*out)[4] += params.lsq_sigma_floor_m * params.lsq_sigma_floor_m;
+  (*out)[8] += params.lsq_sigma_floor_yaw_rad * params.lsq_sigma_floor_yaw_rad;
+  return true;
+}
+
+bool LsqSolver::solve(const ViewGeometry& view, const PositioningParams& params,
+                      std::span<const MarkerObservation> markers, std::span<const MarkerFix> fixes,
+                      std::span<bool> use, LsqResult* out) {
+  State st;
+  int marker_count = gather_points(view, markers, fixes, use, &st);
+  if (marker_count == 0 || point_count_ < params.lsq_min_points) return false;
+  int iterations = 0;
+  bool tilt_estimated = false;
+  const double cost =
+      fit(view, params, fixes, use, &st, &marker_count, &iterations, &tilt_estimated);
+  if (!std::isfinite(cost)) return false;
+  Normal a{};
+  Vector b{};
+  double wr2 = 0.0;
+  int n = 0;
+  accumulate(view, params, use, st, true, &a, &b, &wr2, &n);
+  prior_cost(view, params, st, &a, &b);
+
+  // Accept only a solution that explains the points.
+  if (n < params.lsq_min_points) return false;
+  const double rms = rms_px(view, use, st, n);
+  if (!(rms <= params.lsq_max_rms_px)) return false;
+
+  out->robot = view.robot_from_camera(st.t_w[0], st.t_w[1], camera_yaw(st.r_wc));
+  if (!robot_covariance(view, params, a, wr2, n, out->robot, &out->covariance)) return false;
   out->rms_px = rms;
   out->markers = marker_count;
   out->points = n;

@@ -67,6 +67,15 @@ class LsqSolver {
                   int* iterations);
   double prior_cost(const ViewGeometry& view, const PositioningParams& params, const State& state,
                     Normal* a, Vector* b) const;
+  // The steps of solve(), in order (see lsq_solver.cpp).
+  int gather_points(const ViewGeometry& view, std::span<const MarkerObservation> markers,
+                    std::span<const MarkerFix> fixes, std::span<const bool> use, State* seed);
+  double fit(const ViewGeometry& view, const PositioningParams& params,
+             std::span<const MarkerFix> fixes, std::span<bool> use, State* st, int* marker_count,
+             int* iterations, bool* tilt_estimated);
+  double rms_px(const ViewGeometry& view, std::span<const bool> use, const State& st, int n) const;
+  bool robot_covariance(const ViewGeometry& view, const PositioningParams& params, const Normal& a,
+                        double wr2, int n, const Pose2D& robot, std::array<double, 9>* out) const;
 
   std::array<Point, kMaxMarkersPerFrame * kMaxPointsPerMarker> points_{};
   int point_count_ = 0;
