@@ -126,11 +126,13 @@ void describe(V& v, ServiceConfig& c) {
     v.field("max_blur_to_dot", d.max_blur_to_dot, 0.0f, 100.0f);
   });
   v.section("positioning", [&] {
-    v.choice("mode", c.positioning_mode,
-             Choices<PositioningMode>{{"auto", PositioningMode::kAuto},
-                                      {"axes", PositioningMode::kChangeOfAxes},
-                                      {"barycentric", PositioningMode::kBarycentric},
-                                      {"lsq", PositioningMode::kLeastSquares}});
+    v.choice(
+        "mode", c.positioning_mode,
+        Choices<PositioningMode>{
+            {to_string(PositioningMode::kAuto).data(), PositioningMode::kAuto},
+            {to_string(PositioningMode::kChangeOfAxes).data(), PositioningMode::kChangeOfAxes},
+            {to_string(PositioningMode::kBarycentric).data(), PositioningMode::kBarycentric},
+            {to_string(PositioningMode::kLeastSquares).data(), PositioningMode::kLeastSquares}});
     PositioningParams& q = p.positioning;
     v.field("lsq_max_iterations", q.lsq_max_iterations, 1, 1000);
     v.field("lsq_step_tolerance", q.lsq_step_tolerance, 0.0, 1.0);

@@ -17,18 +17,9 @@ const char* to_string(WriterState state) {
 }
 
 const char* pose_mode_name(uint8_t mode) {
-  switch (mode) {
-    case CEILPOSE_MODE_AUTO:
-      return "auto";
-    case CEILPOSE_MODE_AXES:
-      return "axes";
-    case CEILPOSE_MODE_BARYCENTRIC:
-      return "barycentric";
-    case CEILPOSE_MODE_LSQ:
-      return "lsq";
-    default:
-      return "unknown";
-  }
+  // The names are string_views over literals: NUL-terminated.
+  return mode < kPositioningModes.size() ? to_string(static_cast<PositioningMode>(mode)).data()
+                                         : "unknown";
 }
 
 void set_status_source(StatusRecord* status, const char* text) {

@@ -7,6 +7,7 @@
 
 #include "ceilpose/pose_client.h"
 #include "core/fix_state.h"
+#include "core/positioning_mode.h"
 #include "core/refusal.h"
 
 namespace ceilpose {
@@ -14,6 +15,11 @@ namespace ceilpose {
 using PoseRecord = ::ceilpose_pose;
 using StatusRecord = ::ceilpose_status;
 
+static_assert(static_cast<int>(PositioningMode::kAuto) == CEILPOSE_MODE_AUTO &&
+                  static_cast<int>(PositioningMode::kChangeOfAxes) == CEILPOSE_MODE_AXES &&
+                  static_cast<int>(PositioningMode::kBarycentric) == CEILPOSE_MODE_BARYCENTRIC &&
+                  static_cast<int>(PositioningMode::kLeastSquares) == CEILPOSE_MODE_LSQ,
+              "core/positioning_mode.h and the C client agree");
 static_assert(kRefusalCount <= CEILPOSE_REFUSAL_SLOTS, "a status slot for every refusal");
 
 inline constexpr uint32_t kPoseValid = CEILPOSE_POSE_VALID;

@@ -1,7 +1,8 @@
 // Golden end-to-end accuracy over simulator sets: render, detect, position
 // through the Localizer, and assert limits near what is measured (no looser
-// than 2x the median and p99 measured at 200 frames on 2026-12-01, so that a
-// 2x regression fails; docs/accuracy.md has the figures). Under sanitizers
+// than 2x the median and p99 measured on 2026-12-01 at 200 frames, and at
+// 1000 frames where the tail is heavier, so that a 2x regression fails;
+// docs/accuracy.md has the figures). Under sanitizers
 // fewer frames run (accuracy_frames); their p99 stays below these limits.
 #include <gtest/gtest.h>
 
@@ -107,8 +108,10 @@ void expect_thesis_mode(PositioningMode mode, double min_within_per_axis, double
 }
 
 TEST(Accuracy, ChangeOfAxesAtThesisPointsAtLeastMatchesThesis) {
-  // Measured: 0.34 / 1.77 mm, yaw p99 0.26 deg.
-  expect_thesis_mode(PositioningMode::kChangeOfAxes, 1.0, 0.68, 3.54, 0.52);
+  // One marker, the one nearest the image centre: a heavy tail, so the limits
+  // come from 1000 frames (0.39 / 5.14 mm, yaw p99 0.86 deg; 200 frames gave
+  // 0.34 / 1.77 mm, 0.26 deg).
+  expect_thesis_mode(PositioningMode::kChangeOfAxes, 1.0, 0.78, 10.3, 1.73);
 }
 
 TEST(Accuracy, BarycentricAtThesisPointsAtLeastMatchesThesis) {

@@ -1,4 +1,4 @@
-#include "pipeline/pose_estimate.h"
+#include "core/positioning_mode.h"
 
 namespace ceilpose {
 
