@@ -207,14 +207,17 @@ void describe(V& v, ServiceConfig& c) {
   });
   v.section("dds", [&] {
     DdsConfig& d = c.dds;
+    DdsOptions& o = d.publisher;
     v.field("enabled", d.enabled);
     // RTPS port arithmetic leaves room for domains 0..230 only (Cyclone's limit).
-    v.field("domain_id", d.domain_id, 0, 230);
-    v.text("robot_name", d.robot_name, &check_no_space);
-    v.choice("reliability", d.reliable, Choices<bool>{{"reliable", true}, {"best_effort", false}});
-    v.field("history_depth", d.history_depth, 1, 1000);
-    v.texts("interfaces", d.interfaces, &check_no_space);
-    v.texts("peers", d.peers, &check_no_space);
+    v.field("domain_id", o.domain.domain_id, 0u, 230u);
+    v.text("robot_name", o.robot, &check_no_space);
+    v.choice("reliability", o.reliability,
+             Choices<DdsReliability>{{"reliable", DdsReliability::kReliable},
+                                     {"best_effort", DdsReliability::kBestEffort}});
+    v.field("history_depth", o.history_depth, 1, 1000);
+    v.texts("interfaces", o.domain.interfaces, &check_no_space);
+    v.texts("peers", o.domain.peers, &check_no_space);
     v.field("status_period_ms", d.status_period_ms, 10, 60'000);
   });
   v.section("logging", [&] {

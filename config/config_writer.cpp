@@ -48,6 +48,7 @@ class Writer {
   }
   void field(const char* name, int& v, int, int) { line(name, std::to_string(v)); }
   void field(const char* name, uint64_t& v, uint64_t, uint64_t) { line(name, std::to_string(v)); }
+  void field(const char* name, uint32_t& v, uint32_t, uint32_t) { line(name, std::to_string(v)); }
   void field(const char* name, double& v, double, double) { line(name, double_text(v)); }
   void field(const char* name, float& v, float, float) { line(name, double_text(v)); }
   void field(const char* name, bool& v) { line(name, v ? "true" : "false"); }

@@ -11,6 +11,7 @@
 #include "capture/capture_thread.h"
 #include "capture/frame_source.h"
 #include "core/result.h"
+#include "ipc/dds/dds_options.h"
 #include "ipc/shm/shm_pose_writer.h"
 #include "pipeline/pipeline_config.h"
 #include "pipeline/pose_estimate.h"
@@ -34,13 +35,10 @@ struct CaptureConfig {
 
 struct DdsConfig {
   bool enabled = true;
-  int domain_id = 0;
-  std::string robot_name;               // empty = host name; topic rt/<robot_name>/pose
-  bool reliable = true;                 // reliable, or best effort
-  int history_depth = 10;               // ROS 2's default profile: keep last 10
-  std::vector<std::string> interfaces;  // network interfaces; empty = Cyclone's choice
-  std::vector<std::string> peers;       // unicast discovery peers; empty = multicast
-  int status_period_ms = 1000;          // period of the status topic
+  // The publisher's own options (ipc/dds): robot name (empty = the host's,
+  // resolved at start), domain id, interfaces, peers, reliability, history.
+  DdsOptions publisher;
+  int status_period_ms = 1000;  // period of the status topic (the DDS sink's)
 };
 
 enum class LogLevel : uint8_t { kTrace, kDebug, kInfo, kWarn, kError, kCritical, kOff };

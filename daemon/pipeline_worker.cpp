@@ -71,12 +71,8 @@ void PipelineWorker::run() {
     if (capture_->acquire_latest(&frame, kAcquireTimeoutMs)) {
       process(frame);
       capture_->release(frame);
-      const uint64_t n = frames_.fetch_add(1, std::memory_order_relaxed) + 1;
+      frames_.fetch_add(1, std::memory_order_relaxed);
       progress_->advance(monotonic_ns());
-      if (options_.stall_after_frames != 0 && n >= options_.stall_after_frames) {
-        stall_until_stopped();
-        break;
-      }
     } else if (capture_->finished()) {
       break;
     }
@@ -167,11 +163,6 @@ void PipelineWorker::publish_status(int64_t now_ns, bool all) {
   last_.fps = fps_;
   std::unique_lock lock(snapshot_mutex_, std::try_to_lock);
   if (lock.owns_lock()) snapshot_.fps = fps_;
-}
-
-void PipelineWorker::stall_until_stopped() {
-  while (!stop_.load(std::memory_order_acquire))
-    std::this_thread::sleep_for(std::chrono::milliseconds(20));
 }
 
 }  // namespace ceilpose::daemon

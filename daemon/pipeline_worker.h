@@ -49,10 +49,6 @@ struct PoseSnapshot {
 
 struct WorkerOptions {
   int rt_priority = 0;  // SCHED_FIFO priority of the thread; 0 = normal scheduling
-  // Test hook (CEILPOSE_TEST_STALL_AFTER_FRAMES, docs/service.md): after this
-  // many frames the thread stops making progress until stop(), as a hung
-  // pipeline would. 0 = never.
-  uint64_t stall_after_frames = 0;
   // Frames whose latency is not recorded: the first ones after start touch
   // the pipeline's buffers for the first time (benchmarks skip them).
   uint64_t latency_warmup_frames = 0;
@@ -98,7 +94,6 @@ class PipelineWorker {
   void process(const capture::Frame& frame);
   void publish_status(int64_t now_ns, bool all);
   void update_fps(int64_t now_ns);
-  void stall_until_stopped();
 
   const WorkerOptions options_;
   capture::CaptureThread* capture_;

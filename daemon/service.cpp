@@ -68,36 +68,18 @@ std::shared_ptr<FrameGenerator> frame_generator(const ServiceConfig& c) {
 }
 
 #ifdef CEILPOSE_DAEMON_HAVE_DDS
-// The publisher's options from dds.*; an empty robot name is the host's, as
-// a ROS name.
+// The publisher's options as configured; an empty robot name is the host's,
+// as a ROS name.
 DdsOptions dds_options(const ServiceConfig& c) {
-  DdsOptions o;
-  o.robot = c.dds.robot_name;
+  DdsOptions o = c.dds.publisher;
   if (o.robot.empty()) {
     char host[256] = {};
     gethostname(host, sizeof(host) - 1);
     o.robot = to_ros_name(host);
   }
-  o.domain.domain_id = static_cast<uint32_t>(c.dds.domain_id);
-  o.domain.interfaces = c.dds.interfaces;
-  o.domain.peers = c.dds.peers;
-  o.reliability = c.dds.reliable ? DdsReliability::kReliable : DdsReliability::kBestEffort;
-  o.history_depth = c.dds.history_depth;
   return o;
 }
 #endif
-
-// Test hook, documented in docs/service.md: only tests set it.
-uint64_t stall_after_frames_from_env() {
-  const char* env = std::getenv("CEILPOSE_TEST_STALL_AFTER_FRAMES");
-  if (env == nullptr) return 0;
-  const uint64_t n = std::strtoull(env, nullptr, 10);
-  spdlog::warn(
-      "CEILPOSE_TEST_STALL_AFTER_FRAMES={}: the pipeline will hang after {} frames "
-      "(test hook; the watchdog is expected to fire)",
-      env, n);
-  return n;
-}
 
 class Service {
  public:
@@ -218,7 +200,6 @@ int Service::start_dds() {
 
 int Service::start_pipeline() {
   WorkerOptions wopts;
-  wopts.stall_after_frames = stall_after_frames_from_env();
   wopts.rt_priority = config_.capture.pipeline_rt_priority;
   worker_ = std::make_unique<PipelineWorker>(running_config(config_), wopts, capture_.get(), sinks_,
                                              &progress_);

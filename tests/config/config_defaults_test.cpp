@@ -88,8 +88,8 @@ TEST(ConfigDefaults, MatchSpec) {
   EXPECT_DOUBLE_EQ(c.pipeline.mount.lens_height_m, 0.3048);
   EXPECT_EQ(c.capture.source, "synthetic");
   EXPECT_EQ(c.ipc.name, "/ceilpose");
-  EXPECT_EQ(c.dds.domain_id, 0);
-  EXPECT_EQ(c.dds.robot_name, "");  // host name, resolved at start-up
+  EXPECT_EQ(c.dds.publisher.domain.domain_id, 0u);
+  EXPECT_EQ(c.dds.publisher.robot, "");  // host name, resolved at start-up
 }
 
 TEST(ConfigDefaults, ShippedFileLoads) {
@@ -206,7 +206,7 @@ bool inside(const FieldAddresses::Field& f, const S& module_options) {
 TEST(ConfigSchema, EveryKeyIsBoundToTheOptionsOfTheModuleThatUsesIt) {
   // One home per setting: a key's value lives in its module's own options
   // struct, which the module reads (pipeline's PipelineConfig, capture's
-  // SourceOptions and CaptureThreadOptions, ipc's ShmOptions). The few keys
+  // SourceOptions and CaptureThreadOptions, ipc's ShmOptions and DdsOptions). The few keys
   // ceilposed itself consumes are listed with where; a new key that is in
   // neither fails here until it is bound where it takes effect.
   ServiceConfig c = default_config();
@@ -221,15 +221,15 @@ TEST(ConfigSchema, EveryKeyIsBoundToTheOptionsOfTheModuleThatUsesIt) {
       "logging.problem_report_interval_ms",  // the problem line's period
       "watchdog.max_stall_ms",               // WatchdogGate
       "watchdog.status_interval_ms",         // STATUS= and ShmPoseSink's status period
+      "dds.enabled",                         // whether Service::start_dds runs
+      "dds.status_period_ms",                // DdsPoseSink's status period
   };
   ASSERT_GT(v.fields.size(), 100u);
   for (const auto& f : v.fields) {
     const bool in_module = inside(f, c.pipeline) || inside(f, c.capture.device) ||
-                           inside(f, c.capture.thread) || inside(f, c.ipc);
-    // dds.*: DdsOptions (ipc/dds) is built from them in daemon/service.cpp,
-    // status_period_ms is DdsPoseSink's period.
-    const bool dds = f.key.rfind("dds.", 0) == 0 && inside(f, c.dds);
-    EXPECT_TRUE(in_module || dds || daemon_keys.count(f.key) == 1)
+                           inside(f, c.capture.thread) || inside(f, c.ipc) ||
+                           inside(f, c.dds.publisher);
+    EXPECT_TRUE(in_module || daemon_keys.count(f.key) == 1)
         << f.key << " is bound to no module's options";
   }
 }
@@ -237,7 +237,7 @@ TEST(ConfigSchema, EveryKeyIsBoundToTheOptionsOfTheModuleThatUsesIt) {
 TEST(ConfigSchema, DumpLoadsBackUnchanged) {
   ServiceConfig c = default_config();
   c.pipeline.intrinsics.fx = 612.25;
-  c.dds.peers = {"10.0.0.2", "10.0.0.3"};
+  c.dds.publisher.domain.peers = {"10.0.0.2", "10.0.0.3"};
   c.logging.level = LogLevel::kDebug;
   c.positioning_mode = PositioningMode::kBarycentric;
   const std::string text = dump_config(c);

@@ -39,8 +39,8 @@ TEST(ConfigLoader, ReadsEnumsListsAndColours) {
       "t.yaml");
   ASSERT_TRUE(r) << r.error().message;
   EXPECT_EQ(r->positioning_mode, PositioningMode::kLeastSquares);
-  EXPECT_FALSE(r->dds.reliable);
-  EXPECT_EQ(r->dds.peers, (std::vector<std::string>{"a", "b"}));
+  EXPECT_EQ(r->dds.publisher.reliability, DdsReliability::kBestEffort);
+  EXPECT_EQ(r->dds.publisher.domain.peers, (std::vector<std::string>{"a", "b"}));
   EXPECT_EQ(r->pipeline.layout.red.g, 2);
   EXPECT_EQ(r->logging.level, LogLevel::kDebug);
 }
@@ -127,8 +127,7 @@ TEST(ConfigLoader, SourceGrammarIsCapturesOwn) {
                 HasSubstr("capture.source: expected a source: synthetic | replay:DIR"))
         << bad;
   for (const char* good : {"v4l2:/tmp/fake-video0", "replay:rec", "libcamera", "libcamera:1"}) {
-    auto r =
-        load_config_string(std::string("capture:\n  source: \"") + good + "\"\n", "test.yaml");
+    auto r = load_config_string(std::string("capture:\n  source: \"") + good + "\"\n", "test.yaml");
     EXPECT_TRUE(r.ok()) << good << ": " << r.error().message;
   }
 }
@@ -157,7 +156,7 @@ TEST(ConfigOverrides, CommandLineValueOverridesFile) {
                                               {"dds.domain_id", "7", "--domain"}});
   ASSERT_TRUE(r) << r.error().message;
   EXPECT_EQ(r->capture.source, "replay:/tmp/rec");
-  EXPECT_EQ(r->dds.domain_id, 7);
+  EXPECT_EQ(r->dds.publisher.domain.domain_id, 7u);
 }
 
 TEST(ConfigOverrides, BadValueNamesTheOption) {
