@@ -17,6 +17,7 @@
 #include <vector>
 
 #include "config/config_schema.h"
+#include "core/text_file.h"
 
 namespace ceilpose {
 namespace {
@@ -324,13 +325,19 @@ Result<ServiceConfig> load_config_string(const std::string& yaml_text, const std
 }
 
 Result<ServiceConfig> load_config_file(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) return make_error(path + ": cannot open configuration file: " + std::strerror(errno));
-  std::ostringstream text;
-  text << in.rdbuf();
-  if (in.bad())
-    return make_error(path + ": cannot read configuration file: " + std::strerror(errno));
-  return parse(text.str(), path, nullptr);
+  auto text = read_text_file(path, "configuration file");
+  if (!text) return text.error();
+  return parse(*text, path, nullptr);
+}
+
+Result<ServiceConfig> with_calibration_files(ServiceConfig config) {
+  const CameraIntrinsics& k = config.pipeline.intrinsics;
+  const std::string capture =
+      "the capture (camera.width x camera.height = " + std::to_string(k.width) + "x" +
+      std::to_string(k.height) + ")";
+  auto loaded = load_calibration_files(config.calibration, capture, &config.pipeline);
+  if (!loaded) return loaded.error();
+  return config;
 }
 
 Result<ServiceConfig> apply_overrides(const ServiceConfig& base,

@@ -63,6 +63,7 @@ void describe(V& v, ServiceConfig& c) {
     v.field("cx", k.cx, -1e5, 1e5);
     v.field("cy", k.cy, -1e5, 1e5);
     v.numbers("distortion", k.distortion);
+    v.text("calibration_file", c.calibration.camera_file, check_any_text);
   });
   v.section("mount", [&] {
     CameraMount& m = p.mount;
@@ -91,6 +92,7 @@ void describe(V& v, ServiceConfig& c) {
     v.colour("dot", l.dot);
     v.colour("tile", l.tile);
     v.colour("rail", l.rail);
+    v.text("map", c.calibration.map_file, check_any_text);
   });
   v.section("detector", [&] {
     DetectorParams& d = p.detector;
@@ -143,6 +145,7 @@ void describe(V& v, ServiceConfig& c) {
     v.field("lsq_estimate_tilt", q.lsq_estimate_tilt);
     v.field("lsq_tilt_select_chi2", q.lsq_tilt_select_chi2, 0.0, 1e6);
     v.field("lsq_tilt_prior_rad", q.lsq_tilt_prior_rad, 1e-6, 1.0);
+    v.field("lsq_max_tilt_rad", q.lsq_max_tilt_rad, 0.0, kPi / 2);
     v.field("lsq_tilt_min_markers", q.lsq_tilt_min_markers, 1, kMaxMarkersPerFrame);
     v.field("lsq_estimate_height", q.lsq_estimate_height);
     v.field("grid_tolerance_units", q.grid_tolerance_units, 0.01, 0.5);

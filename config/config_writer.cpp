@@ -161,6 +161,12 @@ std::vector<std::string> changed_config_keys(const ServiceConfig& a, const Servi
   std::vector<std::string> changed;
   for (size_t i = 0; i < va.size(); ++i)
     if (va[i].second != vb[i].second) changed.push_back(va[i].first);
+  // The same map file may hold another survey now: compare what was read.
+  const CeilingMap* ma = a.pipeline.map.get();
+  const CeilingMap* mb = b.pipeline.map.get();
+  const bool map_differs = (ma == nullptr) != (mb == nullptr) || (ma != nullptr && !(*ma == *mb));
+  if (map_differs && a.calibration.map_file == b.calibration.map_file)
+    changed.push_back("ceiling.map");
   return changed;
 }
 

@@ -8,6 +8,7 @@
 #include <utility>
 #include <vector>
 
+#include "calibration/calibration_files.h"
 #include "capture/capture_thread.h"
 #include "capture/frame_source.h"
 #include "core/result.h"
@@ -59,6 +60,9 @@ struct WatchdogConfig {
 
 struct ServiceConfig {
   PipelineConfig pipeline;
+  // camera.calibration_file and ceiling.map: loaded into `pipeline` by
+  // load_calibration_files at start and on every reload.
+  CalibrationFiles calibration;
   PositioningMode positioning_mode = PositioningMode::kAuto;
   CaptureConfig capture;
   ShmOptions ipc;  // the shared-memory segment: name, group, stale_after_ms
@@ -97,7 +101,12 @@ std::vector<std::string> config_key_paths();
 
 // Every key with its value as YAML text ("camera.fx" -> "530.0"), file order.
 std::vector<std::pair<std::string, std::string>> config_values(const ServiceConfig& config);
-// Key paths whose values differ (what a SIGHUP reload changes).
+// Loads the files `config.calibration` names into config.pipeline (the
+// capture size is camera.width x camera.height). Errors name the file.
+Result<ServiceConfig> with_calibration_files(ServiceConfig config);
+
+// Key paths whose values differ (what a SIGHUP reload changes); also
+// "ceiling.map" when the map read from the same file has changed.
 std::vector<std::string> changed_config_keys(const ServiceConfig& a, const ServiceConfig& b);
 
 // The configuration as YAML, every key present (`ceilposed --print-config`).

@@ -24,6 +24,7 @@ constexpr std::array<RefusalText, kRefusalCount> kText{{
     {"too_few_markers", "frames with too few consistent markers for the positioning mode"},
     {"solver_rejected", "frames the solver rejected (no convergence or large residual)"},
     {"filter_rejected", "frames measured but refused by the temporal filter"},
+    {"unmapped_markers", "frames whose whole markers are all missing from the ceiling map"},
 }};
 
 }  // namespace

@@ -25,6 +25,7 @@ enum class Refusal : uint8_t {
   kTooFewMarkers,        // the requested mode needs more consistent markers (barycentric: 3)
   kSolverRejected,       // the solver did not converge or its residual was too large
   kFilterRejected,       // measured, but the temporal filter gave no pose
+  kUnmappedMarkers,      // whole markers decoded, none of them on the ceiling map (SPEC §8)
   kCount,
 };
 

@@ -17,10 +17,12 @@ void print_report(const AccuracyReport& r, bool json) {
         "\"valid_without_whole\":%d,\"availability\":%.6f,\"within_both\":%.6f,"
         "\"within_x\":%.6f,\"within_y\":%.6f,\"median_error_mm\":%.4f,\"p99_error_mm\":%.4f,"
         "\"max_error_mm\":%.4f,\"yaw_p99_deg\":%.4f,\"yaw_max_deg\":%.4f,\"gross\":%d,"
+        "\"mean_nees\":%.4f,\"median_nees\":%.4f,"
         "\"modes\":{\"axes\":%d,\"barycentric\":%d,\"lsq\":%d}}\n",
         r.frames, r.frames_with_whole, r.valid_with_whole, r.valid_without_whole, r.availability,
         r.within_both, r.within_x, r.within_y, r.median_error_mm, r.p99_error_mm, r.max_error_mm,
-        r.yaw_p99_deg, r.yaw_max_deg, r.gross, r.mode_count[1], r.mode_count[2], r.mode_count[3]);
+        r.yaw_p99_deg, r.yaw_max_deg, r.gross, r.mean_nees, r.median_nees, r.mode_count[1],
+        r.mode_count[2], r.mode_count[3]);
     return;
   }
   std::printf("frames with ground truth      %d\n", r.frames);
@@ -34,6 +36,8 @@ void print_report(const AccuracyReport& r, bool json) {
   std::printf("yaw error                     p99 %.3f deg, max %.3f deg\n", r.yaw_p99_deg,
               r.yaw_max_deg);
   std::printf("gross errors                  %d\n", r.gross);
+  std::printf("NEES (x, y, yaw)              mean %.2f, median %.2f (3 = honest covariance)\n",
+              r.mean_nees, r.median_nees);
   std::printf("modes used                    axes %d, barycentric %d, lsq %d\n", r.mode_count[1],
               r.mode_count[2], r.mode_count[3]);
 }
@@ -60,7 +64,7 @@ void add_evaluate_command(CLI::App& app) {
                    args->dir.c_str());
       rc = kExitBadInput;
     }
-    const sim::SceneOptions scene{setup.config.layout, setup.config.intrinsics};
+    const sim::SceneOptions scene{setup.config.layout, setup.config.intrinsics, 1, nullptr};
     AccuracySink accuracy(setup.config.layout.grid_m, [&](const Pose2D& truth) {
       return sim::count_whole_markers(scene, truth, setup.config.mount) > 0;
     });

@@ -7,9 +7,13 @@
 #include <memory>
 #include <string>
 
+#include "calibration/camera_info_file.h"
+#include "calibration/map_file.h"
 #include "config/service_config.h"
+#include "ctl/calibration_options.h"
 #include "ctl/command_registry.h"
 #include "recording/recording_writer.h"
+#include "sim/laid_ceiling.h"
 #include "sim/renderer.h"
 #include "sim/scenarios.h"
 
@@ -20,10 +24,23 @@ struct RenderArgs {
   std::string scenario;
   std::string out_dir;
   std::string config_file;
+  std::string camera_file;       // --camera: the camera, declared and rendered
+  std::string true_camera_file;  // --true-camera: renders with it, declares the other
+  std::string ceiling = "nominal";
+  uint64_t ceiling_seed = 0;  // 0: --seed
+  std::string truth_map_file;
   int frames = 100;
   uint64_t seed = 1;
   bool list = false;
 };
+
+// Fails with the message printed and the exit code set.
+bool report(const Result<void>& r, int code) {
+  if (r) return true;
+  std::cerr << "ceilposectl render: " << r.error().message << "\n";
+  set_exit_code(code);
+  return false;
+}
 
 std::string catalog_text() {
   std::string text;
@@ -49,18 +66,39 @@ void run_render(const RenderArgs& args) {
   // draws the scenario's poses and noise.
   sim::SceneOptions options;
   options.seed = args.seed;
-  CameraMount mount;
+  ServiceConfig config = default_config();
   if (!args.config_file.empty()) {
-    Result<ServiceConfig> config = load_config_file(args.config_file);
-    if (!config) {
-      std::cerr << "ceilposectl render: " << config.error().message << "\n";
-      set_exit_code(kExitBadInput);
-      return;
-    }
-    options.layout = config->pipeline.layout;
-    options.intrinsics = config->pipeline.intrinsics;
-    mount = config->pipeline.mount;
+    Result<ServiceConfig> loaded = load_config_file(args.config_file);
+    if (!report(loaded ? Result<void>() : loaded.error(), kExitBadInput)) return;
+    config = std::move(loaded).value();
   }
+  if (!args.camera_file.empty()) config.calibration.camera_file = args.camera_file;
+  config.calibration.map_file.clear();  // the ceiling is --ceiling's
+  Result<ServiceConfig> calibrated = with_calibration_files(config);
+  if (!report(calibrated ? Result<void>() : calibrated.error(), kExitBadInput)) return;
+  config = std::move(calibrated).value();
+  options.layout = config.pipeline.layout;
+  options.intrinsics = config.pipeline.intrinsics;
+  const CameraMount mount = config.pipeline.mount;
+  // The camera the frames are seen through may differ from the one the
+  // recording declares: an uncalibrated camera for `survey --intrinsics`.
+  if (!args.true_camera_file.empty()) {
+    Result<CameraIntrinsics> truth = read_camera_info_file(args.true_camera_file);
+    if (!report(truth ? Result<void>() : truth.error(), kExitBadInput)) return;
+    if (!report(check_calibration_size(*truth, args.true_camera_file, options.intrinsics.width,
+                                       options.intrinsics.height, "the declared camera"),
+                kExitBadInput))
+      return;
+    options.intrinsics = *truth;
+  }
+  Result<sim::LaidCeiling> laid = sim::LaidCeiling::parse(
+      args.ceiling, options.layout, args.ceiling_seed != 0 ? args.ceiling_seed : args.seed);
+  if (!report(laid ? Result<void>() : laid.error(), kExitUsage)) return;
+  for (const std::string& note : laid->notes()) std::cerr << "ceiling: " << note << "\n";
+  if (!args.truth_map_file.empty() &&
+      !report(write_map_file(args.truth_map_file, laid->truth_map(), options.layout), kExitFailure))
+    return;
+  options.laid = std::make_shared<const sim::LaidCeiling>(std::move(*laid));
   Result<sim::Scenario> scenario =
       sim::make_scenario(args.scenario, options, args.frames, args.seed);
   if (!scenario) {
@@ -69,9 +107,9 @@ void run_render(const RenderArgs& args) {
     return;
   }
   RecordingCamera camera;
-  camera.intrinsics = options.intrinsics;
-  camera.source =
-      "synthetic: ceilpose sim, scenario " + scenario->name + ", seed " + std::to_string(args.seed);
+  camera.intrinsics = config.pipeline.intrinsics;
+  camera.source = "synthetic: ceilpose sim, scenario " + scenario->name + ", seed " +
+                  std::to_string(args.seed) + ", ceiling " + args.ceiling;
   Result<RecordingWriter> writer = RecordingWriter::create(args.out_dir, camera);
   if (!writer) {
     std::cerr << "ceilposectl render: " << writer.error().message << "\n";
@@ -134,6 +172,20 @@ void add_render_command(CLI::App& app) {
                   "Recording directory to create (must not exist or be empty)");
   cmd->add_option("--config", args->config_file,
                   "Configuration file (camera, mount, ceiling layout; SPEC defaults otherwise)");
+  add_camera_option(cmd, &args->camera_file);
+  cmd->add_option("--true-camera", args->true_camera_file,
+                  "Render through this camera (camera_info YAML, same size) while recording.yaml "
+                  "declares --config's / --camera's: an uncalibrated camera");
+  cmd->add_option("--ceiling", args->ceiling,
+                  "Where the markers are: nominal (SPEC §1), or hand-laid[:SIGMA_MM[:SIGMA_DEG]] "
+                  "(default 15 mm, 1 deg per marker; one marker 50 mm off, one missing, one code "
+                  "printed twice; in SPEC §8's datum)")
+      ->capture_default_str();
+  cmd->add_option("--ceiling-seed", args->ceiling_seed,
+                  "Seed of the hand-laid ceiling (default: --seed); the same seed lays the same "
+                  "ceiling for a survey walk and for test poses");
+  cmd->add_option("--truth-map", args->truth_map_file,
+                  "Also write the ceiling's true map (SPEC §8) to this file");
   cmd->add_option("--frames", args->frames, "Number of frames")
       ->capture_default_str()
       ->check(CLI::PositiveNumber);

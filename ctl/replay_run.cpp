@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "config/service_config.h"
+#include "ctl/calibration_options.h"
 
 namespace ceilpose::ctl {
 namespace {
@@ -46,8 +47,9 @@ class HeightsCheck final : public PoseSink {
 void add_replay_options(CLI::App* cmd, ReplayArgs* args) {
   cmd->add_option("--replay", args->dir, "Recording directory (SPEC §4)")->required();
   cmd->add_option("--config", args->config_file,
-                  "Configuration file overriding SPEC's defaults (the camera intrinsics always "
-                  "come from the recording's recording.yaml)");
+                  "Configuration file overriding SPEC's defaults (the camera intrinsics come "
+                  "from the recording's recording.yaml unless a calibration file is given)");
+  add_calibration_options(cmd, &args->calibration);
   cmd->add_flag("--filter", args->filter,
                 "Apply the daemon's temporal filter (default: every frame solved on its own)");
   cmd->add_option("--mode", args->mode_text, "Positioning mode: auto | axes | barycentric | lsq")
@@ -61,6 +63,7 @@ void add_replay_options(CLI::App* cmd, ReplayArgs* args) {
 
 int prepare_replay(const ReplayArgs& args, const char* command, ReplaySetup* setup) {
   PositioningMode mode = PositioningMode::kAuto;
+  CalibrationFiles files;
   if (!args.config_file.empty()) {
     auto loaded = load_config_file(args.config_file);
     if (!loaded.ok()) {
@@ -69,7 +72,10 @@ int prepare_replay(const ReplayArgs& args, const char* command, ReplaySetup* set
     }
     setup->config = loaded->pipeline;
     mode = loaded->positioning_mode;
+    files = loaded->calibration;
   }
+  if (!args.calibration.camera_file.empty()) files.camera_file = args.calibration.camera_file;
+  if (!args.calibration.map_file.empty()) files.map_file = args.calibration.map_file;
   if (!args.mode_text.empty() && !parse_positioning_mode(args.mode_text, &mode)) {
     std::fprintf(stderr, "ceilposectl %s: --mode %s: expected one of %s\n", command,
                  args.mode_text.c_str(), positioning_mode_list().c_str());
@@ -82,6 +88,16 @@ int prepare_replay(const ReplayArgs& args, const char* command, ReplaySetup* set
     return kExitBadInput;
   }
   setup->config.intrinsics = reader->camera().intrinsics;
+  const CameraIntrinsics& k = setup->config.intrinsics;
+  auto calibrated =
+      load_calibration_files(files,
+                             "the recording " + args.dir + " (" + std::to_string(k.width) + "x" +
+                                 std::to_string(k.height) + ")",
+                             &setup->config);
+  if (!calibrated) {
+    std::fprintf(stderr, "ceilposectl %s: %s\n", command, calibrated.error().message.c_str());
+    return kExitBadInput;
+  }
   setup->reader.emplace(std::move(reader.value()));
   return kExitOk;
 }

@@ -6,6 +6,7 @@
 #include <span>
 #include <string>
 
+#include "calibration/calibration_files.h"
 #include "ctl/command_registry.h"
 #include "pipeline/localizer.h"
 #include "pipeline/pipeline_config.h"
@@ -18,12 +19,13 @@ namespace ceilpose::ctl {
 struct ReplayArgs {
   std::string dir;
   std::string config_file;
-  std::string mode_text;  // empty: the configuration's mode (SPEC default auto)
+  CalibrationFiles calibration;  // --camera, --map: over the configuration's
+  std::string mode_text;         // empty: the configuration's mode (SPEC default auto)
   bool filter = false;
   int decode_threads = FramePrefetcher::default_threads();
 };
 
-// Adds --replay, --config, --filter, --mode and --decode-threads.
+// Adds --replay, --config, --camera, --map, --filter, --mode and --decode-threads.
 void add_replay_options(CLI::App* cmd, ReplayArgs* args);
 
 struct ReplaySetup {
@@ -32,8 +34,10 @@ struct ReplaySetup {
   std::optional<RecordingReader> reader;
 };
 
-// Loads the configuration and opens the recording. On failure prints the
-// error (naming file and line) and returns the exit code, else kExitOk.
+// Loads the configuration and opens the recording; the camera is the
+// recording's unless a calibration file (--camera, else camera.calibration_file)
+// replaces it, and the map is --map's, else ceiling.map's. On failure prints
+// the error (naming file and line) and returns the exit code, else kExitOk.
 int prepare_replay(const ReplayArgs& args, const char* command, ReplaySetup* setup);
 
 // Localizes every frame in order, as fast as possible, handing each

@@ -66,7 +66,9 @@ Result<ServiceConfig> resolve_config(const DaemonOptions& options) {
     if (!loaded) return loaded.error();
     base = std::move(loaded).value();
   }
-  return apply_overrides(base, options.overrides);
+  auto configured = apply_overrides(base, options.overrides);
+  if (!configured) return configured;
+  return with_calibration_files(std::move(configured).value());
 }
 
 }  // namespace ceilpose::daemon

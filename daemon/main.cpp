@@ -16,6 +16,7 @@ int main(int argc, char** argv) {
 
   if (!options.check_config_path.empty()) {
     auto checked = load_config_file(options.check_config_path);
+    if (checked) checked = with_calibration_files(std::move(checked).value());
     if (!checked) {
       std::fprintf(stderr, "ceilposed: %s\n", checked.error().message.c_str());
       return kExitBadConfig;

@@ -62,7 +62,8 @@ capture::SourceOptions source_options(const ServiceConfig& c) {
 std::shared_ptr<FrameGenerator> frame_generator(const ServiceConfig& c) {
   if (!capture::is_synthetic_spec(c.capture.source)) return nullptr;
   sim::TrajectoryCameraOptions o;
-  o.scene = sim::SceneOptions{c.pipeline.layout, c.pipeline.intrinsics, c.capture.synthetic_seed};
+  o.scene = sim::SceneOptions{c.pipeline.layout, c.pipeline.intrinsics, c.capture.synthetic_seed,
+                              nullptr};
   o.mount = c.pipeline.mount;
   return std::make_shared<sim::TrajectoryCamera>(o);
 }
@@ -99,9 +100,11 @@ class Service {
   void reload();
   void shutdown();
   // The configuration the pipeline runs with: the file's, with a replayed
-  // recording's own camera model in place of camera.*.
+  // recording's own camera model in place of camera.* unless a calibration
+  // file says what the camera is.
   ServiceConfig running_config(ServiceConfig c) const {
-    if (replay_intrinsics_) c.pipeline.intrinsics = *replay_intrinsics_;
+    if (replay_intrinsics_ && c.calibration.camera_file.empty())
+      c.pipeline.intrinsics = *replay_intrinsics_;
     return c;
   }
 
@@ -152,7 +155,8 @@ int Service::start_capture() {
   // A recording carries its own camera (recording.yaml), as `ceilposectl
   // locate` uses it; a live camera's calibration is the configuration's job.
   CameraIntrinsics recorded;
-  if (capture::is_replay_spec(config_.capture.source) && capture_->camera_intrinsics(&recorded)) {
+  if (capture::is_replay_spec(config_.capture.source) && config_.calibration.camera_file.empty() &&
+      capture_->camera_intrinsics(&recorded)) {
     replay_intrinsics_ = recorded;
     spdlog::info(
         "camera model from the recording: {}x{} px, fx {} fy {} cx {} cy {} (configuration's "
@@ -326,6 +330,7 @@ void Service::reload() {
     // Copy only the live keys, so the running config stays what really runs.
     ServiceConfig live = config_;
     live.pipeline = next->pipeline;
+    live.calibration = next->calibration;
     live.pipeline.intrinsics.width = config_.pipeline.intrinsics.width;
     live.pipeline.intrinsics.height = config_.pipeline.intrinsics.height;
     live.positioning_mode = next->positioning_mode;

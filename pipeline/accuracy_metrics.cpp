@@ -19,6 +19,18 @@ double percentile(const std::vector<double>& sorted, double p) {
   return sorted[std::clamp<size_t>(rank, 1, sorted.size()) - 1];
 }
 
+// e^T C^-1 e for a 3x3 symmetric covariance; negative when C is singular.
+double nees(const std::array<double, 9>& c, double ex, double ey, double eyaw) {
+  const double a = c[0], b = c[1], d = c[2], e = c[4], f = c[5], g = c[8];
+  const double c00 = e * g - f * f, c01 = d * f - b * g, c02 = b * f - d * e;
+  const double det = a * c00 + b * c01 + d * c02;
+  if (!(det > 0.0)) return -1.0;
+  const double c11 = a * g - d * d, c12 = b * d - a * f, c22 = a * e - b * b;
+  const double q = c00 * ex * ex + c11 * ey * ey + c22 * eyaw * eyaw +
+                   2.0 * (c01 * ex * ey + c02 * ex * eyaw + c12 * ey * eyaw);
+  return q / det;
+}
+
 }  // namespace
 
 void AccuracyAccumulator::add(const Pose2D& truth, bool whole, const PoseEstimate& est) {
@@ -42,6 +54,9 @@ void AccuracyAccumulator::add(const Pose2D& truth, bool whole, const PoseEstimat
   if (err_m > kGrossUnits * grid_m_ || yaw_err > kGrossYawRad) ++counts_.gross;
   error_m_.push_back(err_m);
   yaw_error_rad_.push_back(yaw_err);
+  const double q = nees(est.covariance, est.pose.x_m - truth.x_m, est.pose.y_m - truth.y_m,
+                        wrap_angle_rad(est.pose.yaw_rad - truth.yaw_rad));
+  if (q >= 0.0) nees_.push_back(q);
 }
 
 AccuracyReport AccuracyAccumulator::report() const {
@@ -62,6 +77,12 @@ AccuracyReport AccuracyAccumulator::report() const {
   r.max_error_mm = e.empty() ? 0.0 : 1000.0 * e.back();
   r.yaw_p99_deg = kDeg * percentile(y, 0.99);
   r.yaw_max_deg = y.empty() ? 0.0 : kDeg * y.back();
+  std::vector<double> q = nees_;
+  std::sort(q.begin(), q.end());
+  double sum = 0.0;
+  for (double v : q) sum += v;
+  r.mean_nees = q.empty() ? 0.0 : sum / static_cast<double>(q.size());
+  r.median_nees = percentile(q, 0.5);
   return r;
 }
 

@@ -30,7 +30,13 @@ struct AccuracyReport {
   double max_error_mm = 0.0;
   double yaw_p99_deg = 0.0;
   double yaw_max_deg = 0.0;
-  int gross = 0;                    // error > 0.25 grid units or yaw error > 5°
+  int gross = 0;  // error > 0.25 grid units or yaw error > 5°
+  // Mean normalised estimation error squared of (x, y, yaw) against the
+  // reported covariance: 3 for an honest covariance, far above when it
+  // claims too much, below when it claims too little. 0 when no frame had
+  // an invertible covariance.
+  double mean_nees = 0.0;
+  double median_nees = 0.0;
   std::array<int, 4> mode_count{};  // valid poses per PositioningMode
 };
 
@@ -49,6 +55,7 @@ class AccuracyAccumulator {
   int within_both_ = 0, within_x_ = 0, within_y_ = 0;
   std::vector<double> error_m_;
   std::vector<double> yaw_error_rad_;
+  std::vector<double> nees_;
 };
 
 // The accuracy scoring of a replay or a simulated run as a PoseSink: frames

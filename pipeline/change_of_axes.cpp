@@ -10,6 +10,7 @@ ViewGeometry::ViewGeometry(const PipelineConfig& config)
     : intrinsics_(config.intrinsics),
       mount_(config.mount),
       layout_(config.layout),
+      map_(config.map ? *config.map : CeilingMap(config.layout)),
       depth_m_(config.layout.height_m - config.mount.lens_height_m),
       tilt_(tilt_rotation(config.mount.tilt_x_rad, config.mount.tilt_y_rad)) {}
 
@@ -40,14 +41,12 @@ Pose2D ViewGeometry::robot_from_camera(double cam_x_m, double cam_y_m, double ca
 // and the inverse rotation is the transpose:
 //   dx = −sinψ·Xc − cosψ·Yc,  dy = cosψ·Xc − sinψ·Yc.
 // World West (−1, 0) images as (Xc, Yc) ∝ (sinψ, cosψ), so the red→green
-// vector in the image gives ψ = atan2(Δx, Δy).
+// vector in the image gives ψ = atan2(Δx, Δy) for a marker in its nominal
+// orientation.
 bool marker_fix(const ViewGeometry& view, const MarkerObservation& marker, int index,
                 MarkerFix* fix) {
-  const CeilingLayout& layout = view.layout();
-  if (marker.code_i < 0 || marker.code_j < 0 || marker.code_i >= layout.codes() ||
-      marker.code_j >= layout.codes()) {
-    return false;
-  }
+  const MarkerPlacement* placement = view.map().find(marker.code_i, marker.code_j);
+  if (placement == nullptr) return false;
   double xr = 0.0, yr = 0.0, xg = 0.0, yg = 0.0;
   view.level_normalized(marker.red_u_px, marker.red_v_px, &xr, &yr);
   view.level_normalized(marker.green_u_px, marker.green_v_px, &xg, &yg);
@@ -55,11 +54,14 @@ bool marker_fix(const ViewGeometry& view, const MarkerObservation& marker, int i
   // The negated test also refuses NaN from a non-finite measurement.
   if (!(hx * hx + hy * hy >= 1e-12) || !std::isfinite(hx) || !std::isfinite(hy)) return false;
   fix->index = index;
-  fix->world_x_m = marker.code_i * layout.grid_m;
-  fix->world_y_m = marker.code_j * layout.grid_m;
+  fix->placement = placement;
+  fix->world_x_m = placement->x_m;
+  fix->world_y_m = placement->y_m;
   view.level_normalized(marker.centre_u_px, marker.centre_v_px, &fix->centre_x_n, &fix->centre_y_n);
   if (!std::isfinite(fix->centre_x_n) || !std::isfinite(fix->centre_y_n)) return false;
-  fix->cam_yaw_rad = std::atan2(hx, hy);
+  // A marker turned by θ shows its red→green vector turned by θ too: the
+  // image gives ψ − θ.
+  fix->cam_yaw_rad = wrap_angle_rad(std::atan2(hx, hy) + placement->yaw_rad);
   const double s = std::sin(fix->cam_yaw_rad), c = std::cos(fix->cam_yaw_rad);
   const double xc = view.depth_m() * fix->centre_x_n, yc = view.depth_m() * fix->centre_y_n;
   fix->cam_x_m = fix->world_x_m - (-s * xc - c * yc);

@@ -4,6 +4,7 @@
 // position and heading into the robot's pose (mount offset and yaw removed).
 #include "core/camera_model.h"
 #include "core/ceiling_layout.h"
+#include "core/ceiling_map.h"
 #include "core/pose.h"
 #include "pipeline/marker_observation.h"
 
@@ -19,6 +20,8 @@ class ViewGeometry {
   const CameraIntrinsics& intrinsics() const { return intrinsics_; }
   const CameraMount& mount() const { return mount_; }
   const CeilingLayout& layout() const { return layout_; }
+  // The configured map, or the nominal grid when none is configured.
+  const CeilingMap& map() const { return map_; }
   // Lens to ceiling distance H - h, metres.
   double depth_m() const { return depth_m_; }
   // The thesis's scale: pixels per grid unit on the ceiling, fx·g/(H−h).
@@ -39,14 +42,17 @@ class ViewGeometry {
   CameraIntrinsics intrinsics_;
   CameraMount mount_;
   CeilingLayout layout_;
+  CeilingMap map_;
   double depth_m_ = 0.0;
   Mat3 tilt_{};
 };
 
 // What one marker says on its own about the camera.
 struct MarkerFix {
-  int index = 0;           // into the observation span
-  double world_x_m = 0.0;  // marker centre, from its code
+  int index = 0;  // into the observation span
+  // Where the map puts the marker (its centre, rotation and sigmas).
+  const MarkerPlacement* placement = nullptr;
+  double world_x_m = 0.0;  // marker centre, from the map
   double world_y_m = 0.0;
   double centre_x_n = 0.0;  // level normalized image of the centre
   double centre_y_n = 0.0;
@@ -56,7 +62,8 @@ struct MarkerFix {
 };
 
 // Change of Axes on one marker. False when the marker's code is outside the
-// layout or its red and green centres coincide (no heading).
+// layout or not on the map, or its red and green centres coincide (no
+// heading).
 bool marker_fix(const ViewGeometry& view, const MarkerObservation& marker, int index,
                 MarkerFix* fix);
 

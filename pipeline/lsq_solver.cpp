@@ -77,6 +77,41 @@ bool solve_spd(std::array<double, kN * kN> a, const std::array<bool, kN>& active
   return true;
 }
 
+// World directions of the yaw and the two tilt increments at attitude r_wc:
+// the vertical and the level camera's axes.
+std::array<Vec3, 3> increment_axes(const Mat3& r_wc) {
+  const Mat3 lev = level_rotation(camera_yaw(r_wc));
+  return {{{0.0, 0.0, 1.0}, {lev[0], lev[3], lev[6]}, {lev[1], lev[4], lev[7]}}};
+}
+
+// Jacobian of one point's pixel residual r = f·(observed − projected) with
+// respect to the parameters (Param order), for the ceiling point at d = P − t
+// in the world and p = Rᵀd in the camera; `axis` holds the world directions
+// of the yaw and the two tilt increments.
+void point_jacobian(double fx, double fy, const Mat3& rt, const std::array<Vec3, 3>& axis,
+                    const Vec3& d, const Vec3& p, double* jx, double* jy) {
+  const double iz = 1.0 / p[2];
+  double dp[3][kN] = {};
+  for (int row = 0; row < 3; ++row) {
+    dp[row][kTx] = -rt[row * 3 + 0];
+    dp[row][kTy] = -rt[row * 3 + 1];
+    dp[row][kTz] = -rt[row * 3 + 2];
+  }
+  const int rot_cols[3] = {kYaw, kTiltX, kTiltY};
+  for (int c = 0; c < 3; ++c) {
+    const Vec3& w3 = axis[c];
+    const Vec3 cross{d[1] * w3[2] - d[2] * w3[1], d[2] * w3[0] - d[0] * w3[2],
+                     d[0] * w3[1] - d[1] * w3[0]};  // [a]×·w = a × w
+    const Vec3 col = mat_vec(rt, cross);
+    for (int row = 0; row < 3; ++row) dp[row][rot_cols[c]] = col[row];
+  }
+  for (int c = 0; c < kN; ++c) {
+    // ∂r/∂param = −f·∂(projection)/∂param
+    jx[c] = -fx * iz * (dp[0][c] - p[0] * iz * dp[2][c]);
+    jy[c] = -fy * iz * (dp[1][c] - p[1] * iz * dp[2][c]);
+  }
+}
+
 }  // namespace
 
 double LsqSolver::residual2_px(const ViewGeometry& view, const Mat3& r_cw, const Vec3& t_w,
@@ -103,9 +138,7 @@ double LsqSolver::accumulate(const ViewGeometry& view, const PositioningParams& 
   const double fx = view.intrinsics().fx, fy = view.intrinsics().fy;
   const double k = params.lsq_huber_px;
   const Mat3 rt = mat_transpose(st.r_wc);
-  const double psi = camera_yaw(st.r_wc);
-  const Mat3 lev = level_rotation(psi);
-  const Vec3 axis[3] = {{0.0, 0.0, 1.0}, {lev[0], lev[3], lev[6]}, {lev[1], lev[4], lev[7]}};
+  const std::array<Vec3, 3> axis = increment_axes(st.r_wc);
   if (with_jacobian) {
     a->fill(0.0);
     b->fill(0.0);
@@ -126,27 +159,8 @@ double LsqSolver::accumulate(const ViewGeometry& view, const PositioningParams& 
     wr2 += w * r * r;
     ++n;
     if (!with_jacobian) continue;
-    // dp/dparam, columns in Param order.
-    double dp[3][kN] = {};
-    for (int row = 0; row < 3; ++row) {
-      dp[row][kTx] = -rt[row * 3 + 0];
-      dp[row][kTy] = -rt[row * 3 + 1];
-      dp[row][kTz] = -rt[row * 3 + 2];
-    }
-    const int rot_cols[3] = {kYaw, kTiltX, kTiltY};
-    for (int c = 0; c < 3; ++c) {
-      const Vec3& w3 = axis[c];
-      const Vec3 cross{d[1] * w3[2] - d[2] * w3[1], d[2] * w3[0] - d[0] * w3[2],
-                       d[0] * w3[1] - d[1] * w3[0]};  // [a]×·w = a × w
-      const Vec3 col = mat_vec(rt, cross);
-      for (int row = 0; row < 3; ++row) dp[row][rot_cols[c]] = col[row];
-    }
     double jx[kN], jy[kN];
-    for (int c = 0; c < kN; ++c) {
-      // ∂r/∂param = −f·∂(projection)/∂param
-      jx[c] = -fx * iz * (dp[0][c] - p[0] * iz * dp[2][c]);
-      jy[c] = -fy * iz * (dp[1][c] - p[1] * iz * dp[2][c]);
-    }
+    point_jacobian(fx, fy, rt, axis, d, p, jx, jy);
     for (int r1 = 0; r1 < kN; ++r1) {
       (*b)[r1] -= w * (jx[r1] * rx + jy[r1] * ry);
       for (int c = r1; c < kN; ++c) (*a)[r1 * kN + c] += w * (jx[r1] * jx[c] + jy[r1] * jy[c]);
@@ -281,7 +295,9 @@ int LsqSolver::gather_points(const ViewGeometry& view, std::span<const MarkerObs
       }
       Point& p = points_[point_count_++];
       undistort_pixel(view.intrinsics(), u_px, v_px, &p.x_n, &p.y_n);
-      p.world = {fix.world_x_m + e_m, fix.world_y_m + n_m, layout.height_m};
+      double x_m = 0.0, y_m = 0.0;
+      fix.placement->world_point(e_m, n_m, &x_m, &y_m);
+      p.world = {x_m, y_m, layout.height_m};
       p.fix = f;
     };
     if (m.point_count > 0) {
@@ -306,45 +322,55 @@ int LsqSolver::gather_points(const ViewGeometry& view, std::span<const MarkerObs
   return marker_count;
 }
 
-// 2. Free tilt first (robust to a real tilt's large residuals, and it rejects
-// outlier markers), then the same markers with the tilt held at nominal. The
-// held model wins unless freeing the tilt explains the points significantly
+// 2. Free tilt and held tilt, each from the seed with its own marker
+// rejection. The held model wins unless the free one keeps as many markers,
+// finds a tilt a real mount can have, and explains the points significantly
 // better: tilt trades off against translation so closely that estimating it
-// costs ~10x the position noise of holding it, and a tilt too small to be
-// detected is also too small to matter. Returns the cost (not finite: no
-// solution); *tilt_estimated says which model won.
+// costs ~10x the position noise of holding it, a tilt too small to be
+// detected is also too small to matter, and on a ceiling whose markers are a
+// little off their places a free tilt "explains" the offsets by rejecting a
+// good marker and moving the pose by decimetres. Returns the cost (not
+// finite: no solution); *tilt_estimated says which model won.
 double LsqSolver::fit(const ViewGeometry& view, const PositioningParams& params,
                       std::span<const MarkerFix> fixes, std::span<bool> use, State* st,
                       int* marker_count, int* iterations, bool* tilt_estimated) {
   active_ = {true, true, true, false, false, params.lsq_estimate_height};
+  *tilt_estimated = false;
   const bool tilt_allowed =
       params.lsq_estimate_tilt && *marker_count >= params.lsq_tilt_min_markers;
-  active_[kTiltX] = active_[kTiltY] = tilt_allowed;
-  double cost = optimise(view, params, use, fixes, true, st, marker_count, iterations);
-  *tilt_estimated = false;
-  if (!std::isfinite(cost)) return cost;
-  if (!tilt_allowed || *marker_count < params.lsq_tilt_min_markers) {
-    active_[kTiltX] = active_[kTiltY] = false;
-    return cost;
-  }
-  Normal a{};
-  Vector b{};
-  double wr2 = 0.0;
-  int n = 0;
-  accumulate(view, params, use, *st, false, &a, &b, &wr2, &n);
-  int p_free = 0;
-  for (bool act : active_) p_free += act ? 1 : 0;
-  const double sigma2 = cost / std::max(1, 2 * n - p_free);
-  State held = *st;
-  held.r_wc = mat_mul(level_rotation(camera_yaw(st->r_wc)), view.tilt());
-  active_[kTiltX] = active_[kTiltY] = false;
+  if (!tilt_allowed) return optimise(view, params, use, fixes, true, st, marker_count, iterations);
+  const State seed = *st;
+  std::array<bool, kMaxMarkersPerFrame> held_use{};
+  std::copy(use.begin(), use.end(), held_use.begin());
+  const std::span<bool> held_span(held_use.data(), use.size());
+  int held_markers = *marker_count;
+  State held = seed;
   const double held_cost =
-      optimise(view, params, use, fixes, false, &held, marker_count, iterations);
-  if (std::isfinite(held_cost) && held_cost - cost <= params.lsq_tilt_select_chi2 * sigma2) {
+      optimise(view, params, held_span, fixes, true, &held, &held_markers, iterations);
+
+  active_[kTiltX] = active_[kTiltY] = true;
+  double cost = optimise(view, params, use, fixes, true, st, marker_count, iterations);
+  double ta = 0.0, tb = 0.0;
+  camera_tilt(st->r_wc, &ta, &tb);
+  bool free_wins = std::isfinite(cost) && active_[kTiltX] && *marker_count >= held_markers &&
+                   std::hypot(ta - view.mount().tilt_x_rad, tb - view.mount().tilt_y_rad) <=
+                       params.lsq_max_tilt_rad;
+  if (free_wins && std::isfinite(held_cost)) {
+    Normal a{};
+    Vector b{};
+    double wr2 = 0.0;
+    int n = 0;
+    accumulate(view, params, use, *st, false, &a, &b, &wr2, &n);
+    const double sigma2 = cost / std::max(1, 2 * n - 5);
+    free_wins = held_cost - cost > params.lsq_tilt_select_chi2 * sigma2;
+  }
+  if (!free_wins) {
+    active_[kTiltX] = active_[kTiltY] = false;
     *st = held;
+    std::copy(held_use.begin(), held_use.begin() + static_cast<ptrdiff_t>(use.size()), use.begin());
+    *marker_count = held_markers;
     return held_cost;
   }
-  active_[kTiltX] = active_[kTiltY] = true;
   *tilt_estimated = true;
   return cost;
 }
@@ -362,26 +388,125 @@ double LsqSolver::rms_px(const ViewGeometry& view, std::span<const bool> use, co
   return std::sqrt(sum_r2 / n);
 }
 
-// 4. Covariance: sigma^2 (J^T W J)^-1 with sigma^2 = sum w r^2 / (m - p) (m
-// residual components, p parameters), marginalised to (t_x, t_y, psi) by
-// taking that block of the inverse, then carried to the robot's (x, y, yaw)
-// through the mount offset: x = tx - (f cos yaw - l sin yaw),
-// y = ty - (f sin yaw + l cos yaw); plus the configured floors.
+// 4. What the markers' placement adds to the covariance. All points of one
+// marker move together when the marker is off the spot the map gives it, so
+// their errors are not the independent pixel noise that sigma^2 (J^T W J)^-1
+// assumes: per marker, B_k = sum w J^T J_m (J_m the residuals' Jacobian with
+// respect to the marker's centre and rotation) carries a placement error
+// into the normal equations, and M = sum B_k D_k B_k^T is its information
+// cost. D_k holds the map's sigmas plus the placement scatter the
+// grid-consistent markers show (those the solve rejected included: leaving
+// them out would measure only the markers that happen to agree): the shift and turn each marker's
+// residuals ask for, pooled over the 2K - 3 (shift) and K - 1 (turn) degrees of freedom the pose
+// leaves them (K >= 2 markers).
+LsqSolver::Normal LsqSolver::placement_information(const ViewGeometry& view,
+                                                   const PositioningParams& params,
+                                                   std::span<const MarkerFix> fixes,
+                                                   std::span<const bool> consistent,
+                                                   std::span<const bool> use, const State& st) {
+  const double fx = view.intrinsics().fx, fy = view.intrinsics().fy;
+  const double k = params.lsq_huber_px;
+  const Mat3 rt = mat_transpose(st.r_wc);
+  const std::array<Vec3, 3> axis = increment_axes(st.r_wc);
+  const int n_fix = static_cast<int>(fixes.size());
+  for (int f = 0; f < n_fix; ++f) marker_terms_[f] = MarkerTerm{};
+  for (int i = 0; i < point_count_; ++i) {
+    const Point& pt = points_[i];
+    if (!consistent[pt.fix]) continue;
+    const Vec3 d{pt.world[0] - st.t_w[0], pt.world[1] - st.t_w[1], pt.world[2] - st.t_w[2]};
+    const Vec3 p = mat_vec(rt, d);
+    if (p[2] < 1e-3) continue;
+    const double iz = 1.0 / p[2];
+    const double rx = fx * (pt.x_n - p[0] * iz), ry = fy * (pt.y_n - p[1] * iz);
+    const double r = std::sqrt(rx * rx + ry * ry);
+    // Markers the solve rejected carry no weight in the pose but are
+    // evidence of how far off their places the markers are.
+    const double w = !use[pt.fix] ? 0.0 : r <= k ? 1.0 : k / r;
+    double jx[kN], jy[kN];
+    point_jacobian(fx, fy, rt, axis, d, p, jx, jy);
+    // A marker shift moves its points as a camera shift the other way; its
+    // rotation moves a point at (dx, dy) from the centre by (−dy, dx)·dθ.
+    const MarkerFix& fix = fixes[pt.fix];
+    const double ox = pt.world[0] - fix.world_x_m, oy = pt.world[1] - fix.world_y_m;
+    const double mx[3] = {-jx[kTx], -jx[kTy], jx[kTx] * oy - jx[kTy] * ox};
+    const double my[3] = {-jy[kTx], -jy[kTy], jy[kTx] * oy - jy[kTy] * ox};
+    MarkerTerm& term = marker_terms_[pt.fix];
+    for (int r1 = 0; r1 < kN; ++r1)
+      for (int c = 0; c < 3; ++c) term.b[r1 * 3 + c] += w * (jx[r1] * mx[c] + jy[r1] * my[c]);
+    for (int r1 = 0; r1 < 3; ++r1) {
+      term.jtr[r1] += mx[r1] * rx + my[r1] * ry;
+      for (int c = 0; c < 3; ++c) term.jtj[r1 * 3 + c] += mx[r1] * mx[c] + my[r1] * my[c];
+    }
+    ++term.points;
+  }
+  // What each marker's residuals say about its own placement error: the
+  // least-squares shift and turn of the marker alone that would explain
+  // them, (J_m^T J_m)^-1 J_m^T r.
+  int markers = 0;
+  double shift_m2 = 0.0, turn_rad2 = 0.0;
+  for (int f = 0; f < n_fix; ++f) {
+    const MarkerTerm& term = marker_terms_[f];
+    if (term.points == 0) continue;
+    std::array<double, kN * kN> a{};
+    Vector b{}, x{};
+    for (int r1 = 0; r1 < 3; ++r1) {
+      b[r1] = term.jtr[r1];
+      for (int c = 0; c < 3; ++c) a[r1 * kN + c] = term.jtj[r1 * 3 + c];
+    }
+    const std::array<bool, kN> three{true, true, true, false, false, false};
+    if (!solve_spd(a, three, b, &x)) continue;
+    ++markers;
+    shift_m2 += x[0] * x[0] + x[1] * x[1];
+    turn_rad2 += x[2] * x[2];
+  }
+  const double placement_var_m2 = markers >= 2 ? shift_m2 / std::max(1, 2 * markers - 3) : 0.0;
+  const double turn_var_rad2 = markers >= 2 ? turn_rad2 / (markers - 1) : 0.0;
+  Normal m{};
+  for (int f = 0; f < n_fix; ++f) {
+    const MarkerTerm& term = marker_terms_[f];
+    if (term.points == 0 || !use[f]) continue;
+    const MarkerPlacement& pl = *fixes[f].placement;
+    const double dk[3] = {pl.sigma_m * pl.sigma_m + placement_var_m2,
+                          pl.sigma_m * pl.sigma_m + placement_var_m2,
+                          pl.sigma_yaw_rad * pl.sigma_yaw_rad + turn_var_rad2};
+    for (int r1 = 0; r1 < kN; ++r1)
+      for (int c = 0; c < kN; ++c) {
+        double sum = 0.0;
+        for (int q = 0; q < 3; ++q) sum += term.b[r1 * 3 + q] * dk[q] * term.b[c * 3 + q];
+        m[r1 * kN + c] += sum;
+      }
+  }
+  return m;
+}
+
+// 5. Covariance: sigma^2 (J^T W J)^-1 with sigma^2 = sum w r^2 / (m - p) (m
+// residual components, p parameters), plus the placement term
+// (J^T W J)^-1 M (J^T W J)^-1, marginalised to (t_x, t_y, psi) by taking
+// that block, then carried to the robot's (x, y, yaw) through the mount
+// offset: x = tx - (f cos yaw - l sin yaw), y = ty - (f sin yaw + l cos yaw);
+// plus the configured floors.
 bool LsqSolver::robot_covariance(const ViewGeometry& view, const PositioningParams& params,
-                                 const Normal& a, double wr2, int n, const Pose2D& robot,
-                                 std::array<double, 9>* out) const {
+                                 const Normal& a, const Normal& placement, double wr2, int n,
+                                 const Pose2D& robot, std::array<double, 9>* out) const {
   int p_count = 0;
   for (bool act : active_) p_count += act ? 1 : 0;
   const double dof = std::max(1, 2 * n - p_count);
   const double sigma2 = wr2 / dof;
-  Normal inv_cols{};
+  // g = the first three columns of (J^T W J)^-1.
+  std::array<Vector, 3> g{};
   for (int c = 0; c < 3; ++c) {
     Vector e{};
     e[c] = 1.0;
-    Vector col{};
-    if (!solve_spd(a, active_, e, &col)) return false;
-    for (int r = 0; r < 3; ++r) inv_cols[r * 3 + c] = sigma2 * col[r];
+    if (!solve_spd(a, active_, e, &g[c])) return false;
   }
+  std::array<double, 9> cam{};
+  for (int r = 0; r < 3; ++r)
+    for (int c = 0; c < 3; ++c) {
+      double s = sigma2 * g[c][r];
+      for (int i = 0; i < kN; ++i)
+        for (int k = 0; k < kN; ++k) s += g[r][i] * placement[i * kN + k] * g[c][k];
+      cam[r * 3 + c] = s;
+    }
   const double cy = std::cos(robot.yaw_rad), sy = std::sin(robot.yaw_rad);
   const double fwd = view.mount().offset_forward_m, left = view.mount().offset_left_m;
   const double j[9] = {1.0, 0.0, fwd * sy + left * cy, 0.0, 1.0, -(fwd * cy - left * sy), 0.0,
@@ -390,7 +515,7 @@ bool LsqSolver::robot_covariance(const ViewGeometry& view, const PositioningPara
     for (int c = 0; c < 3; ++c) {
       double s = 0.0;
       for (int k1 = 0; k1 < 3; ++k1)
-        for (int k2 = 0; k2 < 3; ++k2) s += j[r * 3 + k1] * inv_cols[k1 * 3 + k2] * j[c * 3 + k2];
+        for (int k2 = 0; k2 < 3; ++k2) s += j[r * 3 + k1] * cam[k1 * 3 + k2] * j[c * 3 + k2];
       (*out)[r * 3 + c] = s;
     }
   (*out)[0] += params.lsq_sigma_floor_m * params.lsq_sigma_floor_m;
@@ -403,6 +528,8 @@ bool LsqSolver::solve(const ViewGeometry& view, const PositioningParams& params,
                       std::span<const MarkerObservation> markers, std::span<const MarkerFix> fixes,
                       std::span<bool> use, LsqResult* out) {
   State st;
+  std::array<bool, kMaxMarkersPerFrame> consistent{};
+  std::copy(use.begin(), use.end(), consistent.begin());
   int marker_count = gather_points(view, markers, fixes, use, &st);
   if (marker_count == 0 || point_count_ < params.lsq_min_points) return false;
   int iterations = 0;
@@ -423,7 +550,10 @@ bool LsqSolver::solve(const ViewGeometry& view, const PositioningParams& params,
   if (!(rms <= params.lsq_max_rms_px)) return false;
 
   out->robot = view.robot_from_camera(st.t_w[0], st.t_w[1], camera_yaw(st.r_wc));
-  if (!robot_covariance(view, params, a, wr2, n, out->robot, &out->covariance)) return false;
+  const Normal placement = placement_information(
+      view, params, fixes, std::span<const bool>(consistent.data(), use.size()), use, st);
+  if (!robot_covariance(view, params, a, placement, wr2, n, out->robot, &out->covariance))
+    return false;
   out->rms_px = rms;
   out->markers = marker_count;
   out->points = n;

@@ -3,7 +3,8 @@
 // yaw, roll/pitch tilt, optionally height) from every point of every
 // consistent marker, by Levenberg–Marquardt on the reprojection error with
 // Huber weights, marker-level outlier rejection, and a covariance of the
-// robot's (x, y, yaw) from the residuals.
+// robot's (x, y, yaw) from the residuals, the map's sigmas and the scatter
+// of the markers about their mapped places.
 #include <array>
 #include <span>
 
@@ -74,12 +75,26 @@ class LsqSolver {
              std::span<const MarkerFix> fixes, std::span<bool> use, State* st, int* marker_count,
              int* iterations, bool* tilt_estimated);
   double rms_px(const ViewGeometry& view, std::span<const bool> use, const State& st, int n) const;
+  Normal placement_information(const ViewGeometry& view, const PositioningParams& params,
+                               std::span<const MarkerFix> fixes, std::span<const bool> consistent,
+                               std::span<const bool> use, const State& st);
   bool robot_covariance(const ViewGeometry& view, const PositioningParams& params, const Normal& a,
-                        double wr2, int n, const Pose2D& robot, std::array<double, 9>* out) const;
+                        const Normal& placement, double wr2, int n, const Pose2D& robot,
+                        std::array<double, 9>* out) const;
+
+  // Per marker: B_k (kParams x 3, row-major), and J_m^T J_m, J_m^T r of its
+  // own placement parameters (centre x, y, rotation).
+  struct MarkerTerm {
+    std::array<double, kParams * 3> b{};
+    std::array<double, 9> jtj{};
+    std::array<double, 3> jtr{};
+    int points = 0;
+  };
 
   std::array<Point, kMaxMarkersPerFrame * kMaxPointsPerMarker> points_{};
   int point_count_ = 0;
   std::array<bool, kParams> active_{};
+  std::array<MarkerTerm, kMaxMarkersPerFrame> marker_terms_{};
 };
 
 }  // namespace ceilpose

@@ -20,11 +20,21 @@ constexpr float kLoneMarkerMinQuality = 0.5f;
 
 Positioner::Positioner(const PipelineConfig& config) : params_(config.positioning), view_(config) {}
 
-void Positioner::set_thesis_covariance(PoseEstimate* estimate) const {
+// The thesis modes have no residuals; their measured accuracy plus the
+// least certain mapped place among the markers they may have used.
+void Positioner::set_thesis_covariance(PoseEstimate* estimate, int fix_count) const {
+  double map_var_m2 = 0.0, map_var_rad2 = 0.0;
+  for (int k = 0; k < fix_count; ++k) {
+    if (!inlier_[k]) continue;
+    const MarkerPlacement& p = *fixes_[k].placement;
+    map_var_m2 = std::max(map_var_m2, p.sigma_m * p.sigma_m);
+    map_var_rad2 = std::max(map_var_rad2, p.sigma_yaw_rad * p.sigma_yaw_rad);
+  }
   estimate->covariance.fill(0.0);
   estimate->covariance[0] = estimate->covariance[4] =
-      params_.thesis_sigma_m * params_.thesis_sigma_m;
-  estimate->covariance[8] = params_.thesis_sigma_yaw_rad * params_.thesis_sigma_yaw_rad;
+      params_.thesis_sigma_m * params_.thesis_sigma_m + map_var_m2;
+  estimate->covariance[8] =
+      params_.thesis_sigma_yaw_rad * params_.thesis_sigma_yaw_rad + map_var_rad2;
 }
 
 // For a level camera, markers d_w apart on the ceiling appear d_w / depth
@@ -72,7 +82,7 @@ PoseEstimate Positioner::change_of_axes(int fix_count) const {
   est.valid = true;
   est.mode = PositioningMode::kChangeOfAxes;
   est.markers = 1;
-  set_thesis_covariance(&est);
+  set_thesis_covariance(&est, fix_count);
   return est;
 }
 
@@ -85,7 +95,7 @@ PoseEstimate Positioner::barycentric(int fix_count) const {
   est.valid = true;
   est.mode = PositioningMode::kBarycentric;
   est.markers = 3;
-  set_thesis_covariance(&est);
+  set_thesis_covariance(&est, fix_count);
   return est;
 }
 
@@ -108,13 +118,16 @@ PoseEstimate Positioner::least_squares(std::span<const MarkerObservation> marker
 
 PoseEstimate Positioner::solve(std::span<const MarkerObservation> markers, PositioningMode mode) {
   // 1. What each whole marker says on its own (Change of Axes).
-  int fix_count = 0;
+  int fix_count = 0, whole = 0;
   const int n = static_cast<int>(std::min<size_t>(markers.size(), kMaxMarkersPerFrame));
   for (int k = 0; k < n; ++k) {
     if (!markers[k].whole) continue;
+    ++whole;
     if (marker_fix(view_, markers[k], k, &fixes_[fix_count])) ++fix_count;
   }
-  if (fix_count == 0) return refused_estimate(Refusal::kNoWholeMarker);
+  if (fix_count == 0)
+    return refused_estimate(whole > 0 && view_.map().surveyed() ? Refusal::kUnmappedMarkers
+                                                                : Refusal::kNoWholeMarker);
   if (fix_count == 1 && markers[fixes_[0].index].quality < kLoneMarkerMinQuality)
     return refused_estimate(Refusal::kLoneMarkerUnclear);
   // 2. Keep the markers that agree on where the camera is.

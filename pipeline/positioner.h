@@ -32,7 +32,7 @@ class Positioner {
   PoseEstimate change_of_axes(int fix_count) const;
   PoseEstimate barycentric(int fix_count) const;
   PoseEstimate least_squares(std::span<const MarkerObservation> markers, int fix_count);
-  void set_thesis_covariance(PoseEstimate* estimate) const;
+  void set_thesis_covariance(PoseEstimate* estimate, int fix_count) const;
   double depth_scale(int fix_count);
   PoseEstimate solve_mode(std::span<const MarkerObservation> markers, int fix_count,
                           PositioningMode mode);

@@ -46,6 +46,12 @@ struct PositioningParams {
   // radians, weighted as one 1-pixel residual. A guard against divergence on
   // few, clustered points, weak enough not to bias a real tilt.
   double lsq_tilt_prior_rad = 0.2;
+  // A free tilt farther than this from the mount's nominal tilt, radians, is
+  // not believed: the held model is used. On a hand-laid ceiling (markers
+  // 15 mm, 1° off) a few frames "found" tilts of ~15° that moved the pose by
+  // half a metre with a residual of 1.7 px; a mount that tilts by more than
+  // 5° is a configuration error (mount.tilt_*), not something to follow.
+  double lsq_max_tilt_rad = 0.09;
   // Fewest markers for solving tilt; with fewer, tilt is held at nominal
   // (the points of one or two markers cannot separate tilt from position).
   int lsq_tilt_min_markers = 3;

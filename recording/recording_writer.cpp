@@ -15,6 +15,7 @@
 #include <opencv2/imgproc.hpp>
 #include <vector>
 
+#include "core/text_file.h"
 #include "recording/frame_file.h"
 #include "recording/recording_format.h"
 
@@ -77,25 +78,6 @@ std::string yaml_text(const RecordingCamera& camera) {
   y += "]   # k1 k2 p1 p2 k3\n";
   if (!camera.source.empty()) y += "source: " + yaml_quoted(camera.source) + "\n";
   return y;
-}
-
-Result<void> write_file(const std::string& path, const void* data, size_t size) {
-  const int fd = ::open(path.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
-  if (fd < 0) return make_error(path + ": cannot create (" + std::strerror(errno) + ")");
-  const auto* p = static_cast<const uint8_t*>(data);
-  size_t done = 0;
-  while (done < size) {
-    const ssize_t n = ::write(fd, p + done, size - done);
-    if (n < 0 && errno == EINTR) continue;
-    if (n < 0) {
-      const int err = errno;
-      ::close(fd);
-      return make_error(path + ": write error (" + std::strerror(err) + ")");
-    }
-    done += static_cast<size_t>(n);
-  }
-  if (::close(fd) != 0) return make_error(path + ": close error (" + std::strerror(errno) + ")");
-  return {};
 }
 
 }  // namespace

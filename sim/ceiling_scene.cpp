@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <utility>
 
 namespace ceilpose::sim {
 namespace {
@@ -46,8 +47,10 @@ float srgb_to_linear(uint8_t v) {
   return static_cast<float>(c <= 0.04045 ? c / 12.92 : std::pow((c + 0.055) / 1.055, 2.4));
 }
 
-CeilingScene::CeilingScene(const CeilingLayout& layout, uint64_t seed)
+CeilingScene::CeilingScene(const CeilingLayout& layout, uint64_t seed,
+                           std::shared_ptr<const LaidCeiling> laid)
     : layout_(layout),
+      laid_(std::move(laid)),
       seed_(seed),
       inv_grid_(1.0 / layout.grid_m),
       half_w_m_(layout.rect_width_m),

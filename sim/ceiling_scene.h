@@ -6,9 +6,11 @@
 #include <array>
 #include <cmath>
 #include <cstdint>
+#include <memory>
 #include <vector>
 
 #include "core/ceiling_layout.h"
+#include "sim/laid_ceiling.h"
 
 namespace ceilpose::sim {
 
@@ -51,7 +53,9 @@ float srgb_to_linear(uint8_t v);
 
 class CeilingScene {
  public:
-  CeilingScene(const CeilingLayout& layout, uint64_t seed);
+  // `laid`: where the markers really are (null: the nominal grid).
+  CeilingScene(const CeilingLayout& layout, uint64_t seed,
+               std::shared_ptr<const LaidCeiling> laid = nullptr);
 
   // Material at ceiling point (x, y). `fixtures` switches light panels on,
   // `clutter_count` selects how many of the scene's clutter objects exist.
@@ -75,6 +79,7 @@ class CeilingScene {
   uint8_t fixture_kind(int64_t ti, int64_t tj) const;
 
   CeilingLayout layout_;
+  std::shared_ptr<const LaidCeiling> laid_;
   uint64_t seed_;
   double inv_grid_ = 1.0;
   double half_w_m_ = 0.0;  // marker half extents
@@ -123,10 +128,22 @@ inline uint8_t CeilingScene::material_at(double x_m, double y_m, bool fixtures,
   const double ri = std::floor(gx + 0.5), rj = std::floor(gy + 0.5);
   const double e = x_m - ri * layout_.grid_m, n = y_m - rj * layout_.grid_m;
   // Markers are drawn over everything; nothing else is placed where they are.
-  if (std::abs(e) <= half_w_m_ && std::abs(n) <= half_h_m_) {
-    const int n_codes = layout_.codes();
-    if (ri >= 0.0 && rj >= 0.0 && ri < n_codes && rj < n_codes)
+  const int n_codes = layout_.codes();
+  const bool on_grid = ri >= 0.0 && rj >= 0.0 && ri < n_codes && rj < n_codes;
+  if (laid_ == nullptr) {
+    if (on_grid && std::abs(e) <= half_w_m_ && std::abs(n) <= half_h_m_)
       return marker_material(static_cast<int>(ri), static_cast<int>(rj), e, n);
+  } else if (on_grid) {
+    // A hand-laid marker stays nearest its own node (offsets of centimetres
+    // against a 0.3 m half grid): look it up there, in its own frame.
+    const LaidMarker& m = laid_->at(static_cast<int>(ri), static_cast<int>(rj));
+    if (m.present) {
+      const double c = std::cos(m.yaw_rad), s = std::sin(m.yaw_rad);
+      const double dx = x_m - m.x_m, dy = y_m - m.y_m;
+      const double me = c * dx + s * dy, mn = -s * dx + c * dy;
+      if (std::abs(me) <= half_w_m_ && std::abs(mn) <= half_h_m_)
+        return marker_material(m.code_i, m.code_j, me, mn);
+    }
   }
   for (int k = 0; k < clutter_count; ++k) {
     const ClutterObject& o = clutter_[k];

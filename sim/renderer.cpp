@@ -42,7 +42,7 @@ CameraIntrinsics scaled_default_intrinsics(int width_px) {
 }
 
 Renderer::Renderer(const SceneOptions& options)
-    : options_(options), scene_(options.layout, options.seed) {
+    : options_(options), scene_(options.layout, options.seed, options.laid) {
   const CameraIntrinsics& k = options_.intrinsics;
   const int cw = k.width + 1, ch = k.height + 1;
   corner_xy_.resize(static_cast<size_t>(cw) * ch * 2);

@@ -13,6 +13,7 @@
 //
 // Thread: one Renderer per thread (render() uses internal buffers).
 #include <cstdint>
+#include <memory>
 #include <vector>
 
 #include "core/camera_model.h"
@@ -29,6 +30,8 @@ struct SceneOptions {
   CeilingLayout layout;
   CameraIntrinsics intrinsics;
   uint64_t seed = 1;  // places fixtures and clutter; seeds the per-frame noise
+  // Where the markers really are; null: the nominal grid (SPEC §1).
+  std::shared_ptr<const LaidCeiling> laid;
 };
 
 // SPEC's default camera (640 x 480, fx = fy = 530) resized to `width_px`

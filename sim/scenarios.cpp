@@ -3,6 +3,7 @@
 #include <array>
 #include <cmath>
 #include <numbers>
+#include <vector>
 
 #include "sim/ceiling_scene.h"
 #include "sim/trajectory.h"
@@ -163,15 +164,75 @@ Result<ScenarioFrame> edges(Context& c) {
                     std::to_string(c.index));
 }
 
-constexpr std::array<Entry, 17> kEntries{{
+// A surveyor's walk: lanes (each from `from` to `to`, grid units) walked
+// one after another at constant speed over the frames, the heading along
+// the lane swinging +-25° so that every marker is seen at many yaws and
+// image positions, read noise 2. Frames spread evenly along the path.
+struct Lane {
+  double x0, y0, x1, y1;
+};
+
+Result<ScenarioFrame> walk(Context& c, const Lane* lanes, size_t lane_count) {
+  double total = 0.0;
+  for (size_t k = 0; k < lane_count; ++k)
+    total += std::hypot(lanes[k].x1 - lanes[k].x0, lanes[k].y1 - lanes[k].y0);
+  double s = total * (c.index + 0.5) / c.frame_count;
+  size_t k = 0;
+  for (; k + 1 < lane_count; ++k) {
+    const double len = std::hypot(lanes[k].x1 - lanes[k].x0, lanes[k].y1 - lanes[k].y0);
+    if (s <= len) break;
+    s -= len;
+  }
+  const Lane& l = lanes[k];
+  const double len = std::hypot(l.x1 - l.x0, l.y1 - l.y0);
+  const double f = len > 0.0 ? std::min(1.0, s / len) : 0.0;
+  const double g = c.options.layout.grid_m;
+  const double heading = std::atan2(l.y1 - l.y0, l.x1 - l.x0);
+  ScenarioFrame fr = at({(l.x0 + f * (l.x1 - l.x0)) * g, (l.y0 + f * (l.y1 - l.y0)) * g,
+                         wrap_angle_rad(heading + 25.0 * kDeg * std::sin(7.0 * s))});
+  fr.effects.read_noise_sigma = 2.0;
+  return fr;
+}
+
+// The whole 8 x 8 grid: East–West lanes one grid unit apart, then
+// North–South lanes, so every marker is seen from every side.
+Result<ScenarioFrame> survey_walk(Context& c) {
+  const double hi = c.options.layout.codes() - 1;
+  std::vector<Lane> lanes;
+  for (int k = 0; k <= static_cast<int>(hi); ++k) {
+    const bool east = k % 2 == 0;
+    lanes.push_back({east ? -0.3 : hi + 0.3, 1.0 * k, east ? hi + 0.3 : -0.3, 1.0 * k});
+  }
+  for (int k = 0; k <= static_cast<int>(hi); ++k) {
+    const bool north = k % 2 == 0;
+    lanes.push_back({hi - k, north ? -0.3 : hi + 0.3, hi - k, north ? hi + 0.3 : -0.3});
+  }
+  return walk(c, lanes.data(), lanes.size());
+}
+
+// Two passes under separate parts of the ceiling that no frame sees
+// together: North–South lanes at x = 0, 0.75, 1.5 grid units, then at
+// x = hi - 1.5 .. hi. Markers between them are seen by neither.
+Result<ScenarioFrame> survey_two_passes(Context& c) {
+  const double hi = c.options.layout.codes() - 1;
+  const Lane lanes[] = {{0.0, -0.3, 0.0, hi + 0.3},
+                        {0.75, hi + 0.3, 0.75, -0.3},
+                        {1.5, -0.3, 1.5, hi + 0.3},
+                        {hi - 1.5, hi + 0.3, hi - 1.5, -0.3},
+                        {hi - 0.75, -0.3, hi - 0.75, hi + 0.3},
+                        {hi, hi + 0.3, hi, -0.3}};
+  return walk(c, lanes, std::size(lanes));
+}
+
+constexpr std::array<Entry, 19> kEntries{{
     {"thesis_points",
      "the thesis's static test points (1.5,1.5) (1.5,2.0) (1.5,2.5) (2.0,2.5) (2.5,2.5) grid "
      "units, frames split evenly between them, random yaw, read noise 2",
      &thesis_points, nullptr},
     {"random", "uniform random poses over the grid interior, random yaw, clean camera", nullptr,
      &clean},
-    {"nominal", "uniform random poses, read noise sigma 0.5-3 levels (the 'nominal' accuracy set)", nullptr,
-     &nominal},
+    {"nominal", "uniform random poses, read noise sigma 0.5-3 levels (the 'nominal' accuracy set)",
+     nullptr, &nominal},
     {"trajectory",
      "patrol loop over the grid at 1.2 m/s (lanes joined by U-turns of one grid unit radius), 30 "
      "fps, read noise 2",
@@ -191,7 +252,8 @@ constexpr std::array<Entry, 17> kEntries{{
     {"occlusion", "random poses, a dark occluder covering 5-35% of the image", nullptr, &occlusion},
     {"clutter", "random poses, 16 red/green non-marker objects on the ceiling", nullptr, &clutter},
     {"stress",
-     "all effects combined at the stress target's levels: gain 0.45-1.6, +-25% colour cast, noise sigma 6, "
+     "all effects combined at the stress target's levels: gain 0.45-1.6, +-25% colour cast, noise "
+     "sigma 6, "
      "defocus 0.5-1.2 px, motion blur <= 3 px, gradient <= 30%, bloom 0.1, 6 clutter objects, "
      "JPEG 60 (no occlusion)",
      nullptr, &stress},
@@ -200,6 +262,14 @@ constexpr std::array<Entry, 17> kEntries{{
     {"edges",
      "poses near and beyond the grid edges with only 0-2 whole markers in view, read noise 2",
      &edges, nullptr},
+    {"survey_walk",
+     "a surveyor's walk for `ceilposectl survey`: East-West lanes one grid unit apart, then "
+     "North-South lanes, heading swinging +-25 deg, read noise 2",
+     &survey_walk, nullptr},
+    {"survey_two_passes",
+     "two survey passes that never see the same marker: North-South lanes over the western "
+     "and the eastern 1.5 grid units, read noise 2",
+     &survey_two_passes, nullptr},
 }};
 
 }  // namespace

@@ -102,7 +102,7 @@ void BM_FrameToPose(benchmark::State& state, bool replay) {
   std::string spec = "synthetic";
   capture::SourceOptions so = config.capture.device;
   sim::TrajectoryCameraOptions camera;
-  camera.scene = sim::SceneOptions{config.pipeline.layout, config.pipeline.intrinsics, 1};
+  camera.scene = sim::SceneOptions{config.pipeline.layout, config.pipeline.intrinsics, 1, nullptr};
   camera.mount = config.pipeline.mount;
   if (replay) {
     spec = "replay:" + replay_dir();

@@ -139,7 +139,8 @@ TEST(ConfigLoader, TopLevelListIsAnError) {
 TEST(ConfigLoader, MissingFileNamesThePath) {
   auto r = load_config_file("/nonexistent/ceilpose.yaml");
   ASSERT_FALSE(r);
-  EXPECT_THAT(r.error().message, HasSubstr("/nonexistent/ceilpose.yaml: cannot open"));
+  EXPECT_THAT(r.error().message,
+              HasSubstr("/nonexistent/ceilpose.yaml: cannot read configuration file"));
 }
 
 TEST(ConfigLoader, FileErrorsNameTheFile) {

@@ -49,7 +49,7 @@ INSTANTIATE_TEST_SUITE_P(
                                 ":2: capture.fps: expected a number, found 'fast'"},
                       BadConfig{"OutOfRange", "dds:\n  domain_id: 999\n",
                                 ":2: dds.domain_id: expected a value in [0, 230], found '999'"},
-                      BadConfig{"MissingFile", nullptr, "cannot open configuration file"}),
+                      BadConfig{"MissingFile", nullptr, "cannot read configuration file"}),
     [](const auto& info) { return std::string(info.param.name); });
 
 TEST(DaemonCommandLine, ValidFileChecksOk) {

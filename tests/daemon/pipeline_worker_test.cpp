@@ -25,7 +25,8 @@ struct Rig {
     capture::SourceOptions so;
     so.fps = 30.0;
     sim::TrajectoryCameraOptions camera;
-    camera.scene = sim::SceneOptions{config.pipeline.layout, config.pipeline.intrinsics, 1};
+    camera.scene =
+        sim::SceneOptions{config.pipeline.layout, config.pipeline.intrinsics, 1, nullptr};
     camera.mount = config.pipeline.mount;
     auto source = capture::make_frame_source("synthetic", so,
                                              std::make_shared<sim::TrajectoryCamera>(camera));

@@ -33,7 +33,7 @@ int accuracy_frames(int release_frames) {
 
 AccuracyReport run_scenario(const std::string& name, int frames, uint64_t seed,
                             PositioningMode mode, bool filter, const PipelineConfig& config) {
-  sim::SceneOptions options{config.layout, config.intrinsics, seed};
+  sim::SceneOptions options{config.layout, config.intrinsics, seed, nullptr};
   auto scenario = sim::make_scenario(name, options, frames, seed);
   if (!scenario.ok()) {
     ADD_FAILURE() << scenario.error().message;

@@ -1,0 +1,125 @@
+#include "calibration/camera_info_file.h"
+
+#include <cmath>
+#include <cstdio>
+#include <vector>
+
+#include "calibration/yaml_fields.h"
+#include "core/text_file.h"
+
+namespace ceilpose {
+namespace {
+
+using namespace calibration_detail;
+
+// `key`: {rows: R, cols: C, data: [R·C finite numbers]}.
+Result<std::vector<double>> matrix(const std::string& path, const YAML::Node& root, const char* key,
+                                   int rows, int cols) {
+  const YAML::Node m = root[key];
+  if (!m.IsDefined() || m.IsNull())
+    return make_error(where(path, root) + ": missing key '" + key + "'");
+  const std::string shape = std::to_string(rows) + " x " + std::to_string(cols);
+  if (!m.IsMap())
+    return make_error(where(path, m) + ": key '" + key + "' must be {rows, cols, data}");
+  auto r = integer(path, m, "rows", std::string(key) + ".rows");
+  if (!r) return r.error();
+  auto c = integer(path, m, "cols", std::string(key) + ".cols");
+  if (!c) return c.error();
+  const YAML::Node data = m["data"];
+  if (*r != rows || *c != cols || !data.IsSequence() ||
+      data.size() != static_cast<size_t>(rows * cols)) {
+    return make_error(where(path, m) + ": key '" + key + "' must be a " + shape + " matrix with " +
+                      std::to_string(rows * cols) + " numbers in data");
+  }
+  std::vector<double> out(static_cast<size_t>(rows * cols));
+  for (size_t k = 0; k < out.size(); ++k) {
+    if (!data[k].IsScalar() || !YAML::convert<double>::decode(data[k], out[k]) ||
+        !std::isfinite(out[k])) {
+      return make_error(where(path, data[k]) + ": " + key + ".data[" + std::to_string(k) +
+                        "] must be a finite number");
+    }
+  }
+  return out;
+}
+
+std::string numbers(const double* v, int n) {
+  std::string out;
+  char buf[40];
+  for (int k = 0; k < n; ++k) {
+    std::snprintf(buf, sizeof buf, "%s%.9g", k == 0 ? "" : ", ", v[k]);
+    out += buf;
+  }
+  return out;
+}
+
+}  // namespace
+
+Result<CameraIntrinsics> read_camera_info_file(const std::string& path) {
+  auto root = load_yaml_mapping(path, "camera calibration (camera_info YAML)");
+  if (!root) return root.error();
+  CameraIntrinsics k;
+  for (auto [key, dst] :
+       {std::pair{"image_width", &k.width}, std::pair{"image_height", &k.height}}) {
+    auto v = integer(path, *root, key, key);
+    if (!v) return v.error();
+    if (*v <= 0 || *v > 16384)
+      return make_error(where(path, (*root)[key]) + ": " + key + " must be in 1..16384");
+    *dst = *v;
+  }
+  auto km = matrix(path, *root, "camera_matrix", 3, 3);
+  if (!km) return km.error();
+  const std::vector<double>& m = *km;
+  if (!(m[0] > 0.0) || !(m[4] > 0.0) || m[1] != 0.0 || m[3] != 0.0 || m[6] != 0.0 || m[7] != 0.0 ||
+      m[8] != 1.0) {
+    return make_error(where(path, (*root)["camera_matrix"]) +
+                      ": camera_matrix must be [fx, 0, cx, 0, fy, cy, 0, 0, 1] with fx, fy > 0");
+  }
+  k.fx = m[0];
+  k.cx = m[2];
+  k.fy = m[4];
+  k.cy = m[5];
+  const YAML::Node model = (*root)["distortion_model"];
+  if (model.IsDefined() && !(model.IsScalar() && model.Scalar() == "plumb_bob")) {
+    return make_error(where(path, model) + ": distortion_model '" +
+                      (model.IsScalar() ? model.Scalar() : std::string("?")) +
+                      "' is not supported (ceilpose's camera model is plumb_bob, SPEC §3)");
+  }
+  auto d = matrix(path, *root, "distortion_coefficients", 1, 5);
+  if (!d) return d.error();
+  for (size_t c = 0; c < 5; ++c) k.distortion[c] = (*d)[c];
+  return k;
+}
+
+std::string camera_info_text(const CameraIntrinsics& k, const std::string& camera_name) {
+  const double km[9] = {k.fx, 0.0, k.cx, 0.0, k.fy, k.cy, 0.0, 0.0, 1.0};
+  const double r[9] = {1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0};
+  const double p[12] = {k.fx, 0.0, k.cx, 0.0, 0.0, k.fy, k.cy, 0.0, 0.0, 0.0, 1.0, 0.0};
+  std::string out;
+  out += "image_width: " + std::to_string(k.width) + "\n";
+  out += "image_height: " + std::to_string(k.height) + "\n";
+  out += "camera_name: " + camera_name + "\n";
+  out += "camera_matrix: {rows: 3, cols: 3, data: [" + numbers(km, 9) + "]}\n";
+  out += "distortion_model: plumb_bob\n";
+  out += "distortion_coefficients: {rows: 1, cols: 5, data: [" + numbers(k.distortion.data(), 5) +
+         "]}\n";
+  out += "rectification_matrix: {rows: 3, cols: 3, data: [" + numbers(r, 9) + "]}\n";
+  out += "projection_matrix: {rows: 3, cols: 4, data: [" + numbers(p, 12) + "]}\n";
+  return out;
+}
+
+Result<void> write_camera_info_file(const std::string& path, const CameraIntrinsics& camera,
+                                    const std::string& camera_name) {
+  return replace_file(path, camera_info_text(camera, camera_name));
+}
+
+Result<void> check_calibration_size(const CameraIntrinsics& calibration, const std::string& origin,
+                                    int capture_width_px, int capture_height_px,
+                                    const std::string& capture) {
+  if (calibration.width == capture_width_px && calibration.height == capture_height_px) return {};
+  return make_error(origin + ": calibrated for " + std::to_string(calibration.width) + "x" +
+                    std::to_string(calibration.height) + " px but " + capture + " is " +
+                    std::to_string(capture_width_px) + "x" + std::to_string(capture_height_px) +
+                    " px (SPEC §9: recalibrate at the capture size; no rescaling)");
+}
+
+}  // namespace ceilpose

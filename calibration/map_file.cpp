@@ -1,0 +1,166 @@
+#include "calibration/map_file.h"
+
+#include <cmath>
+#include <cstdio>
+
+#include "calibration/yaml_fields.h"
+#include "core/text_file.h"
+
+namespace ceilpose {
+namespace {
+
+using namespace calibration_detail;
+
+// The map's ceiling must be the configured one: a map surveyed under another
+// height or grid would place every marker wrongly without any error.
+Result<void> check_ceiling(const std::string& path, const YAML::Node& root,
+                           const CeilingLayout& layout) {
+  const YAML::Node ceiling = root["ceiling"];
+  if (!ceiling.IsDefined() || ceiling.IsNull()) return {};  // optional: the configured one
+  if (!ceiling.IsMap())
+    return make_error(where(path, ceiling) + ": key 'ceiling' must be a mapping");
+  if (auto known = only_keys(path, ceiling, {"height_m", "grid_m", "bits"}, "ceiling"); !known)
+    return known;
+  for (auto [key, configured] :
+       {std::pair{"height_m", layout.height_m}, std::pair{"grid_m", layout.grid_m}}) {
+    auto v = finite_number(path, ceiling, key, std::string("ceiling.") + key, &configured);
+    if (!v) return v.error();
+    if (std::abs(*v - configured) > 1e-6 * std::max(1.0, std::abs(configured))) {
+      char msg[200];
+      std::snprintf(msg, sizeof msg,
+                    ": ceiling.%s is %.6f m but the configuration's ceiling.%s is %.6f m (survey "
+                    "again or configure the ceiling the map was made for)",
+                    key, *v, key, configured);
+      return make_error(where(path, ceiling[key]) + msg);
+    }
+  }
+  auto bits = integer(path, ceiling, "bits", "ceiling.bits", &layout.bits);
+  if (!bits) return bits.error();
+  if (*bits != layout.bits) {
+    return make_error(where(path, ceiling["bits"]) + ": ceiling.bits is " + std::to_string(*bits) +
+                      " but the configuration's ceiling.bits is " + std::to_string(layout.bits));
+  }
+  return {};
+}
+
+Result<void> read_marker(const std::string& path, const YAML::Node& node, size_t index,
+                         CeilingMap* map) {
+  const std::string name = "markers[" + std::to_string(index) + "]";
+  if (!node.IsMap()) return make_error(where(path, node) + ": " + name + " must be a mapping");
+  if (auto known = only_keys(
+          path, node, {"code", "x_m", "y_m", "yaw_rad", "sigma_m", "sigma_yaw_rad", "observations"},
+          name);
+      !known) {
+    return known;
+  }
+  const YAML::Node code = node["code"];
+  int ij[2] = {0, 0};
+  bool code_ok = code.IsSequence() && code.size() == 2;
+  for (int k = 0; code_ok && k < 2; ++k)
+    code_ok = code[k].IsScalar() && YAML::convert<int>::decode(code[k], ij[k]);
+  if (!code_ok) {
+    return make_error(where(path, code.IsDefined() ? code : node) + ": " + name +
+                      ".code must be a pair of integers [i, j]");
+  }
+  const std::string entry =
+      name + " (code [" + std::to_string(ij[0]) + ", " + std::to_string(ij[1]) + "])";
+  if (!map->valid_code(ij[0], ij[1])) {
+    return make_error(where(path, code) + ": " + entry + ": code outside the ceiling's " +
+                      std::to_string(map->codes()) + " x " + std::to_string(map->codes()) +
+                      " codes (ceiling.bits)");
+  }
+  if (map->find(ij[0], ij[1]) != nullptr)
+    return make_error(where(path, code) + ": " + entry + ": code listed twice");
+  MarkerPlacement p;
+  p.present = true;
+  const double zero = 0.0;
+  struct Field {
+    const char* key;
+    double* dst;
+    const double* fallback;
+    bool non_negative;
+  };
+  for (const Field& f :
+       {Field{"x_m", &p.x_m, nullptr, false}, Field{"y_m", &p.y_m, nullptr, false},
+        Field{"yaw_rad", &p.yaw_rad, &zero, false}, Field{"sigma_m", &p.sigma_m, &zero, true},
+        Field{"sigma_yaw_rad", &p.sigma_yaw_rad, &zero, true}}) {
+    auto v = finite_number(path, node, f.key, entry + "." + f.key, f.fallback);
+    if (!v) return v.error();
+    if (f.non_negative && *v < 0.0)
+      return make_error(where(path, node[f.key]) + ": " + entry + "." + f.key + " is negative");
+    *f.dst = *v;
+  }
+  const int none = 0;
+  auto obs = integer(path, node, "observations", entry + ".observations", &none);
+  if (!obs) return obs.error();
+  if (*obs < 0)
+    return make_error(where(path, node["observations"]) + ": " + entry +
+                      ".observations is negative");
+  p.observations = *obs;
+  map->set(ij[0], ij[1], p);
+  return {};
+}
+
+}  // namespace
+
+Result<CeilingMap> read_map_file(const std::string& path, const CeilingLayout& layout) {
+  auto root = load_yaml_mapping(path, "ceiling map");
+  if (!root) return root.error();
+  if (auto known = only_keys(path, *root, {"format", "version", "ceiling", "markers"}, "");
+      !known) {
+    return known.error();
+  }
+  auto format = text(path, *root, "format", "format");
+  if (!format) return format.error();
+  if (*format != kMapFormat) {
+    return make_error(where(path, (*root)["format"]) + ": format '" + *format + "' is not '" +
+                      kMapFormat + "'");
+  }
+  auto version = integer(path, *root, "version", "version");
+  if (!version) return version.error();
+  if (*version != kMapVersion) {
+    return make_error(where(path, (*root)["version"]) + ": unsupported version " +
+                      std::to_string(*version) + " (this reader knows version " +
+                      std::to_string(kMapVersion) + ")");
+  }
+  if (auto ceiling = check_ceiling(path, *root, layout); !ceiling) return ceiling.error();
+  const YAML::Node markers = (*root)["markers"];
+  if (!markers.IsDefined() || !markers.IsSequence() || markers.size() == 0) {
+    return make_error((markers.IsDefined() ? where(path, markers) : path + ":1") +
+                      ": key 'markers' must be a non-empty list of markers");
+  }
+  CeilingMap map = CeilingMap::empty(layout);
+  for (size_t k = 0; k < markers.size(); ++k) {
+    if (auto read = read_marker(path, markers[k], k, &map); !read) return read.error();
+  }
+  return map;
+}
+
+std::string map_text(const CeilingMap& map, const CeilingLayout& layout) {
+  std::string out;
+  char line[256];
+  std::snprintf(line, sizeof line,
+                "format: %s\nversion: %d\nceiling:\n  height_m: %.6f\n  grid_m: %.6f\n  bits: "
+                "%d\nmarkers:\n",
+                kMapFormat, kMapVersion, layout.height_m, layout.grid_m, layout.bits);
+  out += line;
+  for (int j = 0; j < map.codes(); ++j)
+    for (int i = 0; i < map.codes(); ++i) {
+      const MarkerPlacement* p = map.find(i, j);
+      if (p == nullptr) continue;
+      std::snprintf(line, sizeof line,
+                    "  - code: [%d, %d]\n    x_m: %.6f\n    y_m: %.6f\n    yaw_rad: %.7f\n    "
+                    "sigma_m: %.7f\n    sigma_yaw_rad: %.7f\n    observations: %d\n",
+                    i, j, p->x_m, p->y_m, p->yaw_rad, p->sigma_m, p->sigma_yaw_rad,
+                    p->observations);
+      out += line;
+    }
+  return out;
+}
+
+Result<void> write_map_file(const std::string& path, const CeilingMap& map,
+                            const CeilingLayout& layout) {
+  return replace_file(path, map_text(map, layout));
+}
+
+}  // namespace ceilpose
