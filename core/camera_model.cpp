@@ -52,12 +52,7 @@ CameraPose camera_pose_from_robot(const Pose2D& robot, const CameraMount& mount)
 }
 
 void distort_normalized(const CameraIntrinsics& k, double x, double y, double* xd, double* yd) {
-  const double k1 = k.distortion[0], k2 = k.distortion[1], p1 = k.distortion[2],
-               p2 = k.distortion[3], k3 = k.distortion[4];
-  const double r2 = x * x + y * y;
-  const double radial = 1.0 + r2 * (k1 + r2 * (k2 + r2 * k3));
-  *xd = x * radial + 2.0 * p1 * x * y + p2 * (r2 + 2.0 * x * x);
-  *yd = y * radial + p1 * (r2 + 2.0 * y * y) + 2.0 * p2 * x * y;
+  plumb_bob(k.distortion.data(), x, y, xd, yd);
 }
 
 bool project_camera_point(const CameraIntrinsics& k, const Vec3& p, double* u_px, double* v_px) {

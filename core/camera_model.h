@@ -20,6 +20,7 @@ struct CameraIntrinsics {
   std::array<double, 5> distortion{0.0, 0.0, 0.0, 0.0, 0.0};  // k1 k2 p1 p2 k3
 
   bool has_distortion() const;
+  bool operator==(const CameraIntrinsics&) const = default;
 };
 
 // Where the camera sits on the robot. SPEC defaults: lens 0.3048 m above the
@@ -49,6 +50,16 @@ Mat3 tilt_rotation(double tilt_x_rad, double tilt_y_rad);
 Mat3 mat_mul(const Mat3& a, const Mat3& b);
 Mat3 mat_transpose(const Mat3& a);
 Vec3 mat_vec(const Mat3& a, const Vec3& v);
+
+// OpenCV's plumb_bob on normalized coordinates, d = (k1, k2, p1, p2, k3);
+// a template so that the survey's automatic derivatives use the same formula.
+template <typename T, typename D>
+void plumb_bob(const D* d, const T& x, const T& y, T* xd, T* yd) {
+  const T r2 = x * x + y * y;
+  const T radial = T(1.0) + r2 * (d[0] + r2 * (d[1] + r2 * d[4]));
+  *xd = x * radial + T(2.0) * d[2] * x * y + d[3] * (r2 + T(2.0) * x * x);
+  *yd = y * radial + d[2] * (r2 + T(2.0) * y * y) + T(2.0) * d[3] * x * y;
+}
 
 // Applies plumb_bob distortion to normalized coordinates (x = Xc/Zc, y = Yc/Zc).
 void distort_normalized(const CameraIntrinsics& k, double x, double y, double* xd, double* yd);

@@ -4,6 +4,7 @@
 // fix state and, when there is no pose, why.
 #include <array>
 #include <cstdint>
+#include <span>
 
 #include "core/fix_state.h"
 #include "core/pose.h"
@@ -31,7 +32,10 @@ struct Localization {
   // when it did but the filter refused it). published.refusal says why the
   // published pose is invalid: the same, or kNone while coasting.
   Refusal refusal = Refusal::kNone;
-  int markers_decoded = 0;                      // markers the pipeline decoded
+  int markers_decoded = 0;  // markers the pipeline decoded
+  // The decoded markers themselves (the survey's observations); valid until
+  // the next frame is localized.
+  std::span<const MarkerObservation> markers;
   std::array<int64_t, kStageCount> stage_ns{};  // duration of each pipeline stage
   int64_t localize_ns = 0;                      // whole localization, filter included
 
