@@ -1,5 +1,6 @@
 #include "calibration/camera_info_file.h"
 
+#include <charconv>
 #include <cmath>
 #include <cstdio>
 #include <vector>
@@ -42,12 +43,16 @@ Result<std::vector<double>> matrix(const std::string& path, const YAML::Node& ro
   return out;
 }
 
+// Shortest text that reads back as the same double; always with a decimal
+// point, as ROS writes them.
 std::string numbers(const double* v, int n) {
   std::string out;
   char buf[40];
   for (int k = 0; k < n; ++k) {
-    std::snprintf(buf, sizeof buf, "%s%.9g", k == 0 ? "" : ", ", v[k]);
-    out += buf;
+    const auto end = std::to_chars(buf, buf + sizeof buf, v[k]).ptr;
+    std::string text(buf, end);
+    if (text.find_first_of(".en") == std::string::npos) text += ".0";
+    out += (k == 0 ? "" : ", ") + text;
   }
   return out;
 }

@@ -52,6 +52,23 @@ INSTANTIATE_TEST_SUITE_P(
                       BadConfig{"MissingFile", nullptr, "cannot read configuration file"}),
     [](const auto& info) { return std::string(info.param.name); });
 
+TEST(DaemonCommandLine, ABadMapStopsTheDaemonNamingTheMapAndTheEntry) {
+  const std::string map =
+      write_temp_file("map.yaml",
+                      "format: ceilpose-map\nversion: 1\nmarkers:\n  - code: [9, 1]\n    x_m: 1\n"
+                      "    y_m: 1\n");
+  const std::string config = write_temp_file("with-map.yaml", "ceiling:\n  map: " + map + "\n");
+  for (const std::vector<std::string>& args :
+       {std::vector<std::string>{"--check-config", config},
+        std::vector<std::string>{"--config", config, "--shm", unique_shm_name(), "--no-dds"}}) {
+    auto r = run_daemon(args);
+    EXPECT_EQ(r.exit.code, daemon::kExitBadConfig) << r.err;
+    EXPECT_NE(r.err.find(map + ":4: markers[0] (code [9, 1]): code outside the ceiling's 8 x 8"),
+              std::string::npos)
+        << r.err;
+  }
+}
+
 TEST(DaemonCommandLine, ValidFileChecksOk) {
   auto r =
       run_daemon({"--check-config", std::string(CEILPOSE_SOURCE_DIR) + "/config/ceilpose.yaml"});

@@ -5,6 +5,7 @@
 #include <signal.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <chrono>
 #include <fstream>
 #include <map>
@@ -181,6 +182,59 @@ TEST_F(DaemonLifecycle, SighupSaysWhichKeysNeedARestart) {
   ASSERT_TRUE(daemon->wait(5000).has_value());
   EXPECT_NE(daemon->err().find("capture.fps changed but needs a restart"), std::string::npos)
       << daemon->err();
+}
+
+// A map that lists one marker only: every other decoded marker is unused.
+std::string one_marker_map(double x_m) {
+  return "format: ceilpose-map\nversion: 1\nmarkers:\n  - code: [3, 3]\n    x_m: " +
+         std::to_string(x_m) + "\n    y_m: 1.8288\n";
+}
+
+TEST_F(DaemonLifecycle, SighupLoadsTheMapAndABrokenMapKeepsTheOldOne) {
+  const std::string map = write_temp_file("map.yaml", one_marker_map(1.8288));
+  auto daemon = start();
+  ASSERT_TRUE(notify_.wait_for("READY=1", kStartTimeoutMs)) << daemon->err();
+  auto reader = ShmPoseReader::open_waiting(shm_, 5000);
+  ASSERT_TRUE(reader) << reader.error().message;
+  PoseRecord pose{};
+  int most_markers = 0;
+  for (int i = 0; i < 30; ++i) {
+    pose = next_pose(*reader, pose.seq);
+    most_markers = std::max<int>(most_markers, pose.markers);
+  }
+  ASSERT_GT(most_markers, 1) << "the nominal grid should use several markers per frame";
+
+  { std::ofstream(config_) << config_text() << "ceiling:\n  map: " << map << "\n"; }
+  daemon->signal(SIGHUP);
+  ASSERT_TRUE(notify_.wait_for("READY=1", 5000));
+  // Poses published after the reload: not the ring's backlog, nor the frame
+  // the pipeline was on when the new map arrived (it applies it between frames).
+  auto most_markers_now = [&] {
+    int most = 0;
+    pose.seq = reader->latest_seq() + 2;
+    for (int i = 0; i < 60; ++i) {
+      // Read the notifications as systemd does: a full socket blocks sd_notify.
+      while (notify_.receive(0)) {
+      }
+      pose = next_pose(*reader, pose.seq);
+      most = std::max<int>(most, pose.markers);
+    }
+    return most;
+  };
+  EXPECT_LE(most_markers_now(), 1) << "markers the map does not list were used\n" << daemon->err();
+  EXPECT_NE(daemon->err().find("SIGHUP: applied ceiling.map"), std::string::npos) << daemon->err();
+
+  // The same file, now broken: the running map stays, and the log says why.
+  { std::ofstream(map) << one_marker_map(1.8288) << "  - code: [3, 3]\n    x_m: 1\n    y_m: 1\n"; }
+  daemon->signal(SIGHUP);
+  ASSERT_TRUE(notify_.wait_for("READY=1", 5000));
+  EXPECT_LE(most_markers_now(), 1) << daemon->err();
+  EXPECT_NE(daemon->err().find("keeping the running configuration: " + map + ":7"),
+            std::string::npos)
+      << daemon->err();
+  EXPECT_NE(daemon->err().find("code listed twice"), std::string::npos) << daemon->err();
+  daemon->signal(SIGTERM);
+  ASSERT_TRUE(daemon->wait(5000).has_value()) << daemon->err();
 }
 
 TEST_F(DaemonLifecycle, PublishesOnDdsAndDisposesOnSigterm) {

@@ -238,6 +238,65 @@ TEST_F(LocateCommand, HeightsThatDisagreeWithTheMarkersGiveNoPoseAndSaySo) {
   EXPECT_TRUE(r.err.empty()) << r.err;
 }
 
+TEST_F(LocateCommand, MapMovesThePosesWithTheMarkersAndLeavesUnlistedMarkersUnused) {
+  const std::vector<Pose2D> poses{{1.2, 1.5, 0.3}, {2.0, 2.2, -2.0}};
+  const fs::path rec = record(poses);
+  // Every marker 10 mm further East than nominal: the poses follow them.
+  std::string shifted = "format: ceilpose-map\nversion: 1\nmarkers:\n";
+  for (int j = 0; j < 8; ++j)
+    for (int i = 0; i < 8; ++i)
+      shifted += "  - code: [" + std::to_string(i) + ", " + std::to_string(j) +
+                 "]\n    x_m: " + std::to_string(i * 0.6096 + 0.01) +
+                 "\n    y_m: " + std::to_string(j * 0.6096) + "\n    sigma_m: 0.0005\n";
+  const fs::path map = dir_ / "map.yaml";
+  std::ofstream(map) << shifted;
+  const CommandRun r = run("locate --replay " + rec.string() + " --map " + map.string());
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const auto out = lines(r.out);
+  ASSERT_EQ(out.size(), 2u);
+  for (size_t k = 0; k < poses.size(); ++k) {
+    EXPECT_NEAR(field(out[k], "x_m"), poses[k].x_m + 0.01, 0.001) << out[k];
+    EXPECT_NEAR(field(out[k], "y_m"), poses[k].y_m, 0.001) << out[k];
+    // The map's sigmas are in the covariance: 0.5 mm per marker over ~9
+    // markers is ~0.17 mm (the pixel noise alone gives ~0.05 mm).
+    const size_t cov = out[k].find("\"cov\":[");
+    ASSERT_NE(cov, std::string::npos) << out[k];
+    EXPECT_GE(std::strtod(out[k].c_str() + cov + 7, nullptr), 1.5e-8) << out[k];
+  }
+  // A map that lists a marker far from these poses only: nothing is used.
+  const fs::path far = dir_ / "far.yaml";
+  std::ofstream(far) << "format: ceilpose-map\nversion: 1\nmarkers:\n  - code: [7, 7]\n"
+                        "    x_m: 4.2672\n    y_m: 4.2672\n";
+  const CommandRun unmapped = run("locate --replay " + rec.string() + " --map " + far.string());
+  ASSERT_EQ(unmapped.exit_code, 0) << unmapped.err;
+  for (const std::string& l : lines(unmapped.out))
+    EXPECT_NE(l.find("\"valid\":false,\"x_m\":null"), std::string::npos) << l;
+  for (const std::string& l : lines(unmapped.out))
+    EXPECT_NE(l.find("\"refusal\":\"unmapped_markers\""), std::string::npos) << l;
+}
+
+TEST_F(LocateCommand, BadMapOrCameraFileExitsFourNamingTheFile) {
+  const fs::path rec = record({{1.2, 1.5, 0.3}});
+  const fs::path map = dir_ / "twice.yaml";
+  std::ofstream(map) << "format: ceilpose-map\nversion: 1\nmarkers:\n"
+                        "  - code: [1, 1]\n    x_m: 0.6\n    y_m: 0.6\n"
+                        "  - code: [1, 1]\n    x_m: 0.6\n    y_m: 0.6\n";
+  const CommandRun r = run("locate --replay " + rec.string() + " --map " + map.string());
+  EXPECT_EQ(r.exit_code, 4);
+  EXPECT_NE(r.err.find(map.string() + ":7: markers[1] (code [1, 1]): code listed twice"),
+            std::string::npos)
+      << r.err;
+  const fs::path camera = dir_ / "camera.yaml";
+  std::ofstream(camera) << "image_width: 320\nimage_height: 240\ncamera_matrix: {rows: 3, cols: "
+                           "3, data: [265, 0, 159.5, 0, 265, 119.5, 0, 0, 1]}\n"
+                           "distortion_coefficients: {rows: 1, cols: 5, data: [0, 0, 0, 0, 0]}\n";
+  const CommandRun c = run("evaluate --replay " + rec.string() + " --camera " + camera.string());
+  EXPECT_EQ(c.exit_code, 4);
+  EXPECT_NE(c.err.find(camera.string() + ": calibrated for 320x240 px but the recording"),
+            std::string::npos)
+      << c.err;
+}
+
 TEST_F(LocateCommand, EvaluateScoresAgainstGroundTruth) {
   const fs::path rec = record({{1.2, 1.5, 0.3}, {2.0, 2.2, -2.0}, {-20.0, -20.0, 0.0}});
   const CommandRun r = run("evaluate --json --replay " + rec.string());
