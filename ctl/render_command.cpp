@@ -7,12 +7,14 @@
 #include <memory>
 #include <string>
 
+#include "calibration/board_spec.h"
 #include "calibration/camera_info_file.h"
 #include "calibration/map_file.h"
 #include "config/service_config.h"
 #include "ctl/calibration_options.h"
 #include "ctl/command_registry.h"
 #include "recording/recording_writer.h"
+#include "sim/checkerboard.h"
 #include "sim/laid_ceiling.h"
 #include "sim/renderer.h"
 #include "sim/scenarios.h"
@@ -29,6 +31,7 @@ struct RenderArgs {
   std::string ceiling = "nominal";
   uint64_t ceiling_seed = 0;  // 0: --seed
   std::string truth_map_file;
+  std::string board = "checkerboard:9x6:0.03";
   int frames = 100;
   uint64_t seed = 1;
   bool list = false;
@@ -47,7 +50,43 @@ std::string catalog_text() {
   for (const auto& [name, description] : sim::scenario_catalog())
     text += "  " + name + std::string(name.size() < 15 ? 15 - name.size() : 1, ' ') + description +
             "\n";
+  text +=
+      "  checkerboard   views of a checkerboard (--board) for `calibrate camera`: 0.35-0.9 m, "
+      "tilted 10-45 deg, no ground truth\n";
   return text;
+}
+
+// Views of a checkerboard (for `calibrate camera`) instead of the ceiling:
+// no ground-truth columns; the camera seen through is options.intrinsics.
+void render_checkerboard_set(const RenderArgs& args, const ServiceConfig& config,
+                             const sim::SceneOptions& options) {
+  Result<BoardSpec> spec = parse_board_spec(args.board);
+  if (!report(spec ? Result<void>() : spec.error(), kExitUsage)) return;
+  const sim::Checkerboard board{spec->cols, spec->rows, spec->square_m};
+  const std::vector<sim::BoardPose> views =
+      sim::checkerboard_views(options.intrinsics, board, args.frames, args.seed);
+  RecordingCamera camera;
+  camera.intrinsics = config.pipeline.intrinsics;
+  camera.source =
+      "synthetic: ceilpose sim, checkerboard " + args.board + ", seed " + std::to_string(args.seed);
+  Result<RecordingWriter> writer = RecordingWriter::create(args.out_dir, camera);
+  if (!report(writer ? Result<void>() : writer.error(), kExitFailure)) return;
+  const sim::CheckerboardCamera seen_through(options.intrinsics);
+  Image frame;
+  for (size_t i = 0; i < views.size(); ++i) {
+    seen_through.render(board, views[i], 2.0, args.seed + i, &frame);
+    if (!report(writer->append(
+                    frame.view(),
+                    sim::kScenarioStart_ns + static_cast<int64_t>(i) * sim::kScenarioFramePeriod_ns,
+                    nullptr),
+                kExitFailure))
+      return;
+    std::fprintf(stderr, "\rrendering checkerboard: %zu/%zu", i + 1, views.size());
+  }
+  std::fputc('\n', stderr);
+  if (!report(writer->close(), kExitFailure)) return;
+  std::cerr << "wrote " << views.size() << " checkerboard views to " << args.out_dir << "\n";
+  set_exit_code(kExitOk);
 }
 
 void run_render(const RenderArgs& args) {
@@ -99,6 +138,7 @@ void run_render(const RenderArgs& args) {
       !report(write_map_file(args.truth_map_file, laid->truth_map(), options.layout), kExitFailure))
     return;
   options.laid = std::make_shared<const sim::LaidCeiling>(std::move(*laid));
+  if (args.scenario == "checkerboard") return render_checkerboard_set(args, config, options);
   Result<sim::Scenario> scenario =
       sim::make_scenario(args.scenario, options, args.frames, args.seed);
   if (!scenario) {
@@ -184,6 +224,10 @@ void add_render_command(CLI::App& app) {
   cmd->add_option("--ceiling-seed", args->ceiling_seed,
                   "Seed of the hand-laid ceiling (default: --seed); the same seed lays the same "
                   "ceiling for a survey walk and for test poses");
+  cmd->add_option("--board", args->board,
+                  "With --scenario checkerboard: the board, checkerboard:COLSxROWS:SQUARE_M "
+                  "(views at 0.35-0.9 m, tilted 10-45 deg, over the whole image)")
+      ->capture_default_str();
   cmd->add_option("--truth-map", args->truth_map_file,
                   "Also write the ceiling's true map (SPEC §8) to this file");
   cmd->add_option("--frames", args->frames, "Number of frames")

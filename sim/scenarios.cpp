@@ -224,7 +224,38 @@ Result<ScenarioFrame> survey_two_passes(Context& c) {
   return walk(c, lanes, std::size(lanes));
 }
 
-constexpr std::array<Entry, 19> kEntries{{
+// `calibrate mount`'s drive: at the middle of the grid, a turn in place of
+// 400°, 1.2 m straight ahead, a half turn in place, 1.2 m straight back
+// (shares of the frames 45/15/25/15 %), read noise 2.
+Result<ScenarioFrame> mount_drive(Context& c) {
+  const double g = c.options.layout.grid_m;
+  const double f = (c.index + 0.5) / c.frame_count;
+  const double x0 = 2.5 * g, y0 = 3.0 * g, turn1 = 400.0 * kDeg, run_m = 1.2;
+  Pose2D p{x0, y0, 0.0};
+  if (f < 0.45) {
+    p.yaw_rad = turn1 * f / 0.45;
+  } else if (f < 0.60) {
+    p.yaw_rad = turn1;
+    const double d = run_m * (f - 0.45) / 0.15;
+    p.x_m += d * std::cos(turn1);
+    p.y_m += d * std::sin(turn1);
+  } else if (f < 0.85) {
+    p.x_m += run_m * std::cos(turn1);
+    p.y_m += run_m * std::sin(turn1);
+    p.yaw_rad = turn1 + kPi * (f - 0.60) / 0.25;
+  } else {
+    const double d = run_m * (1.0 - (f - 0.85) / 0.15);
+    p.x_m += d * std::cos(turn1);
+    p.y_m += d * std::sin(turn1);
+    p.yaw_rad = turn1 + kPi;
+  }
+  p.yaw_rad = wrap_angle_rad(p.yaw_rad);
+  ScenarioFrame fr = at(p);
+  fr.effects.read_noise_sigma = 2.0;
+  return fr;
+}
+
+constexpr std::array<Entry, 20> kEntries{{
     {"thesis_points",
      "the thesis's static test points (1.5,1.5) (1.5,2.0) (1.5,2.5) (2.0,2.5) (2.5,2.5) grid "
      "units, frames split evenly between them, random yaw, read noise 2",
@@ -266,6 +297,10 @@ constexpr std::array<Entry, 19> kEntries{{
      "a surveyor's walk for `ceilposectl survey`: East-West lanes one grid unit apart, then "
      "North-South lanes, heading swinging +-25 deg, read noise 2",
      &survey_walk, nullptr},
+    {"mount_drive",
+     "`calibrate mount`'s drive: a 400 deg turn in place, 1.2 m straight ahead, a half turn, "
+     "1.2 m back (45/15/25/15 % of the frames; render with --config for the mount), read noise 2",
+     &mount_drive, nullptr},
     {"survey_two_passes",
      "two survey passes that never see the same marker: North-South lanes over the western "
      "and the eastern 1.5 grid units, read noise 2",

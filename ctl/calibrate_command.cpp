@@ -1,0 +1,284 @@
+// ceilposectl calibrate camera | mount (SPEC §10): the camera's intrinsics
+// from a recording of a checkerboard (OpenCV), and the camera's place on the
+// robot from a recording of turns in place and straight drives.
+#include <unistd.h>
+
+#include <cmath>
+#include <cstdio>
+#include <memory>
+#include <numbers>
+#include <opencv2/calib3d.hpp>
+#include <opencv2/imgproc.hpp>
+#include <string>
+#include <vector>
+
+#include "calibration/board_spec.h"
+#include "calibration/camera_info_file.h"
+#include "calibration/mount_estimate.h"
+#include "core/text_file.h"
+#include "ctl/calibration_options.h"
+#include "ctl/command_registry.h"
+#include "ctl/replay_run.h"
+#include "recording/recording_reader.h"
+
+namespace ceilpose::ctl {
+namespace {
+
+constexpr double kDeg = 180.0 / std::numbers::pi;
+constexpr int kMinViews = 10;
+// The views' corners should reach this share of a 4 x 4 grid of image cells
+// and the boards tilt at least this much, or the calibration is weak.
+constexpr double kMinCoverage = 0.75;
+constexpr double kMinTiltDeg = 15.0;
+
+struct CameraArgs {
+  std::string dir;
+  std::string board = "";
+  std::string out_file = "camera.yaml";
+};
+
+struct Views {
+  std::vector<std::vector<cv::Point2f>> corners;
+  std::vector<int64_t> index;  // recording frame index of each view
+  size_t frames = 0;
+};
+
+// Finds the board in every frame: corners refined to sub-pixel.
+Result<Views> find_boards(const RecordingReader& reader, const BoardSpec& board) {
+  Views views;
+  const bool tty = ::isatty(STDERR_FILENO) == 1;
+  const cv::Size pattern(board.cols, board.rows);
+  Image image;
+  for (size_t i = 0; i < reader.rows().size(); ++i) {
+    if (auto loaded = reader.load_frame(i, &image); !loaded) return loaded.error();
+    const ImageView v = image.view();
+    cv::Mat rgb(v.height, v.width, CV_8UC3, const_cast<uint8_t*>(v.data), v.stride_bytes);
+    cv::Mat gray;
+    if (v.format == PixelFormat::kGray8)
+      gray = cv::Mat(v.height, v.width, CV_8UC1, const_cast<uint8_t*>(v.data), v.stride_bytes);
+    else
+      cv::cvtColor(rgb, gray,
+                   v.format == PixelFormat::kBgr24 ? cv::COLOR_BGR2GRAY : cv::COLOR_RGB2GRAY);
+    std::vector<cv::Point2f> corners;
+    const bool found = cv::findChessboardCorners(
+        gray, pattern, corners,
+        cv::CALIB_CB_ADAPTIVE_THRESH | cv::CALIB_CB_NORMALIZE_IMAGE | cv::CALIB_CB_FAST_CHECK);
+    ++views.frames;
+    if (tty)
+      std::fprintf(stderr, "\rcalibrate camera: frame %zu/%zu, board in %zu", i + 1,
+                   reader.rows().size(), views.corners.size() + (found ? 1 : 0));
+    if (!found) continue;
+    cv::cornerSubPix(gray, corners, cv::Size(5, 5), cv::Size(-1, -1),
+                     cv::TermCriteria(cv::TermCriteria::EPS + cv::TermCriteria::COUNT, 50, 1e-4));
+    views.corners.push_back(std::move(corners));
+    views.index.push_back(reader.rows()[i].index);
+  }
+  if (tty) std::fputc('\n', stderr);
+  std::fprintf(stderr, "calibrate camera: the board was found in %zu of %zu frames\n",
+               views.corners.size(), views.frames);
+  return views;
+}
+
+void run_calibrate_camera(const CameraArgs& args) {
+  Result<BoardSpec> board = parse_board_spec(args.board);
+  if (!board) {
+    std::fprintf(stderr, "ceilposectl calibrate camera: %s\n", board.error().message.c_str());
+    return set_exit_code(kExitUsage);
+  }
+  auto reader = RecordingReader::open(args.dir);
+  if (!reader) {
+    std::fprintf(stderr, "ceilposectl calibrate camera: %s\n", reader.error().message.c_str());
+    return set_exit_code(kExitBadInput);
+  }
+  auto views = find_boards(*reader, *board);
+  if (!views) {
+    std::fprintf(stderr, "ceilposectl calibrate camera: %s\n", views.error().message.c_str());
+    return set_exit_code(kExitBadInput);
+  }
+  const size_t n = views->corners.size();
+  if (n < static_cast<size_t>(kMinViews)) {
+    std::fprintf(stderr,
+                 "ceilposectl calibrate camera: the %dx%d board was found in %zu of %zu frames; "
+                 "at least %d views are needed (check --board's inner-corner count, lighting and "
+                 "focus)\n",
+                 board->cols, board->rows, n, views->frames, kMinViews);
+    return set_exit_code(kExitFailure);
+  }
+  std::vector<cv::Point3f> model;
+  for (int r = 0; r < board->rows; ++r)
+    for (int c = 0; c < board->cols; ++c)
+      model.emplace_back(static_cast<float>(c * board->square_m),
+                         static_cast<float>(r * board->square_m), 0.0f);
+  const std::vector<std::vector<cv::Point3f>> object(n, model);
+  const CameraIntrinsics& declared = reader->camera().intrinsics;
+  const cv::Size size(declared.width, declared.height);
+  cv::Mat k, dist;
+  std::vector<cv::Mat> rvecs, tvecs;
+  cv::Mat std_intrinsics, std_extrinsics, per_view;
+  const double rms = cv::calibrateCamera(object, views->corners, size, k, dist, rvecs, tvecs,
+                                         std_intrinsics, std_extrinsics, per_view);
+  std::fprintf(stderr, "calibrate camera: %zu views, RMS reprojection error %.3f px\n", n, rms);
+  double max_tilt_deg = 0.0;
+  for (size_t v = 0; v < n; ++v) {
+    cv::Mat r;
+    cv::Rodrigues(rvecs[v], r);
+    const double tilt_deg = kDeg * std::acos(std::min(1.0, std::abs(r.at<double>(2, 2))));
+    max_tilt_deg = std::max(max_tilt_deg, tilt_deg);
+    std::fprintf(stderr, "  view %3zu (frame %lld): %.3f px, board tilted %.1f deg\n", v,
+                 static_cast<long long>(views->index[v]), per_view.at<double>(static_cast<int>(v)),
+                 tilt_deg);
+  }
+  // Coverage: which cells of a 4 x 4 grid over the image have corners.
+  bool cell[4][4] = {};
+  for (const auto& view : views->corners)
+    for (const cv::Point2f& p : view)
+      cell[std::clamp(static_cast<int>(4 * p.y / size.height), 0, 3)]
+          [std::clamp(static_cast<int>(4 * p.x / size.width), 0, 3)] = true;
+  int covered = 0;
+  for (const auto& row : cell)
+    for (bool c : row) covered += c ? 1 : 0;
+  if (covered < kMinCoverage * 16)
+    std::fprintf(stderr,
+                 "calibrate camera: warning: the board reached only %d of 16 image cells (4 x 4): "
+                 "distortion is extrapolated where it never was; show it in the corners too\n",
+                 covered);
+  if (max_tilt_deg < kMinTiltDeg)
+    std::fprintf(stderr,
+                 "calibrate camera: warning: the board never tilted more than %.1f deg: the focal "
+                 "length is weakly determined; tilt it 20-45 deg in several directions\n",
+                 max_tilt_deg);
+  CameraIntrinsics out = declared;
+  out.fx = k.at<double>(0, 0);
+  out.fy = k.at<double>(1, 1);
+  out.cx = k.at<double>(0, 2);
+  out.cy = k.at<double>(1, 2);
+  for (int c = 0; c < 5; ++c) out.distortion[static_cast<size_t>(c)] = dist.at<double>(c);
+  std::fprintf(stderr,
+               "calibrate camera: fx %.2f +- %.2f, fy %.2f +- %.2f, cx %.2f +- %.2f, cy %.2f +- "
+               "%.2f px; k1 %.5f k2 %.5f p1 %.6f p2 %.6f k3 %.5f\n",
+               out.fx, std_intrinsics.at<double>(0), out.fy, std_intrinsics.at<double>(1), out.cx,
+               std_intrinsics.at<double>(2), out.cy, std_intrinsics.at<double>(3),
+               out.distortion[0], out.distortion[1], out.distortion[2], out.distortion[3],
+               out.distortion[4]);
+  if (auto wrote = write_camera_info_file(args.out_file, out); !wrote) {
+    std::fprintf(stderr, "ceilposectl calibrate camera: %s\n", wrote.error().message.c_str());
+    return set_exit_code(kExitFailure);
+  }
+  std::fprintf(stderr,
+               "calibrate camera: wrote %s (use it as --camera or camera.calibration_file)\n",
+               args.out_file.c_str());
+  set_exit_code(kExitOk);
+}
+
+struct MountArgs {
+  ReplayArgs replay;
+  std::string out_file = "mount.yaml";
+};
+
+// Every frame's camera pose: the robot's pose as if the camera sat at the
+// robot's origin with no mounting yaw (the rest of the mount, lens height
+// and tilt, as configured).
+class CameraTrack final : public PoseSink {
+ public:
+  void consume(const Localization& loc) override {
+    if (!loc.measured.valid) return;
+    samples.push_back({loc.frame.timestamp_ns * 1e-9, loc.measured.pose.x_m, loc.measured.pose.y_m,
+                       loc.measured.pose.yaw_rad});
+  }
+  std::vector<CameraSample> samples;
+};
+
+void run_calibrate_mount(MountArgs& args) {
+  ReplaySetup setup;
+  args.replay.mode_text = "lsq";
+  int rc = prepare_replay(args.replay, "calibrate mount", &setup);
+  if (rc != kExitOk) return set_exit_code(rc);
+  setup.config.mount.offset_forward_m = setup.config.mount.offset_left_m = 0.0;
+  setup.config.mount.yaw_rad = 0.0;
+  CameraTrack track;
+  PoseSink* sinks[] = {&track};
+  rc = run_replay(args.replay, "calibrate mount", setup, sinks);
+  if (rc != kExitOk) return set_exit_code(rc);
+  std::fprintf(stderr, "calibrate mount: %zu of %zu frames localized\n", track.samples.size(),
+               setup.reader->rows().size());
+  auto m = estimate_mount(track.samples);
+  if (!m) {
+    std::fprintf(stderr, "ceilposectl calibrate mount: %s\n", m.error().message.c_str());
+    return set_exit_code(kExitFailure);
+  }
+  std::fprintf(stderr,
+               "calibrate mount: %d turns in place (%.0f deg, camera circle RMS %.2f mm), %d "
+               "straight drives (%.2f m, line RMS %.2f mm)\n",
+               m->turn_segments, m->turned_rad * kDeg, 1000.0 * m->circle_rms_m,
+               m->straight_segments, m->driven_m, 1000.0 * m->line_rms_m);
+  std::fprintf(stderr,
+               "calibrate mount: camera %.1f +- %.1f mm forward, %.1f +- %.1f mm left of the "
+               "robot origin, turned %.3f +- %.3f deg\n",
+               1000.0 * m->offset_forward_m, 1000.0 * m->sigma_forward_m, 1000.0 * m->offset_left_m,
+               1000.0 * m->sigma_left_m, m->yaw_rad * kDeg, m->sigma_yaw_rad * kDeg);
+  char text[512];
+  std::snprintf(text, sizeof text,
+                "# ceilposectl calibrate mount --replay %s: %d turns in place (%.0f deg), %.2f m "
+                "straight.\n# Use as --config (or merge into the configuration's mount: section).\n"
+                "mount:\n  offset_forward_m: %.5f   # +- %.5f\n  offset_left_m: %.5f      # +- "
+                "%.5f\n  yaw_rad: %.6f            # +- %.6f\n",
+                args.replay.dir.c_str(), m->turn_segments, m->turned_rad * kDeg, m->driven_m,
+                m->offset_forward_m, m->sigma_forward_m, m->offset_left_m, m->sigma_left_m,
+                m->yaw_rad, m->sigma_yaw_rad);
+  if (auto wrote = replace_file(args.out_file, text); !wrote) {
+    std::fprintf(stderr, "ceilposectl calibrate mount: %s\n", wrote.error().message.c_str());
+    return set_exit_code(kExitFailure);
+  }
+  std::fprintf(stderr, "calibrate mount: wrote %s\n", args.out_file.c_str());
+  set_exit_code(kExitOk);
+}
+
+void add_calibrate_mount_command(CLI::App* calibrate) {
+  auto args = std::make_shared<MountArgs>();
+  CLI::App* mount = calibrate->add_subcommand(
+      "mount",
+      "The camera's place on the robot (offset forward and left of the robot origin, mounting "
+      "yaw) from a recording in which the robot turns in place (360 deg or more in total) and "
+      "drives straight forward (1 m or more): the camera circles the origin while turning and "
+      "moves along the robot's heading while driving. Prints them with their 1-sigma and writes "
+      "a configuration fragment (mount: section) usable as --config. The lens height and tilt "
+      "are the configuration's.\n"
+      "Exit 0 ok, 1 the recording lacks the turn or the drive (says which) or cannot write, 2 "
+      "usage, 4 malformed recording, configuration, map or camera file.");
+  mount->add_option("--replay", args->replay.dir, "Recording of the turns and drives")->required();
+  mount->add_option("--config", args->replay.config_file,
+                    "Configuration (ceiling, camera, lens height; its mount offset and yaw are "
+                    "what is measured)");
+  add_calibration_options(mount, &args->replay.calibration);
+  mount->add_option("--out", args->out_file, "Configuration fragment to write")
+      ->capture_default_str();
+  mount->callback([args] { run_calibrate_mount(*args); });
+}
+
+void add_calibrate_command(CLI::App& app) {
+  CLI::App* calibrate = app.add_subcommand(
+      "calibrate", "Calibrate the camera's intrinsics or its mount on the robot (SPEC §10)");
+  calibrate->require_subcommand(1);
+  auto cam = std::make_shared<CameraArgs>();
+  CLI::App* camera = calibrate->add_subcommand(
+      "camera",
+      "Intrinsics from a recording of a checkerboard (OpenCV findChessboardCorners, cornerSubPix, "
+      "calibrateCamera): fx, fy, cx, cy and plumb_bob, written as ROS camera_info YAML (SPEC "
+      "§9). Prints the RMS and per-view reprojection errors in px; warns when the views do not "
+      "cover the image or the board never tilts; refuses with fewer than 10 views.\n"
+      "Exit 0 ok, 1 too few views or cannot write, 2 usage, 4 malformed recording.");
+  camera->add_option("--replay", cam->dir, "Recording of the board (SPEC §4)")->required();
+  camera
+      ->add_option("--board", cam->board,
+                   "checkerboard:COLSxROWS:SQUARE_M (inner corners as OpenCV counts them, "
+                   "square side in metres)")
+      ->required();
+  camera->add_option("--out", cam->out_file, "camera_info file to write")->capture_default_str();
+  camera->callback([cam] { run_calibrate_camera(*cam); });
+  add_calibrate_mount_command(calibrate);
+}
+
+const CommandRegistrar kReg{"calibrate", &add_calibrate_command};
+
+}  // namespace
+}  // namespace ceilpose::ctl
