@@ -1,9 +1,15 @@
 // ceilposectl locate: localizes every frame of a recording and prints one
 // JSON object per frame (SPEC §5).
+#include <sys/stat.h>
+
+#include <cerrno>
 #include <cinttypes>
 #include <cstdio>
+#include <cstring>
+#include <vector>
 
 #include "core/json_text.h"
+#include "ctl/annotate_sink.h"
 #include "ctl/command_registry.h"
 #include "ctl/replay_run.h"
 
@@ -48,6 +54,8 @@ class JsonLinesSink final : public PoseSink {
 
 void add_locate_command(CLI::App& app) {
   auto args = std::make_shared<ReplayArgs>();
+  auto annotate_dir = std::make_shared<std::string>();
+  auto annotate_refused = std::make_shared<bool>(false);
   CLI::App* cmd = app.add_subcommand(
       "locate",
       "Localize every frame of a recording in order, as fast as possible; one JSON object per "
@@ -57,13 +65,35 @@ void add_locate_command(CLI::App& app) {
       "upper triangle of the (x, y, yaw) covariance: xx, xy, xyaw, yy, yyaw, yawyaw). Errors "
       "on stderr; exit 4 for a malformed recording or configuration, 2 for usage.");
   add_replay_options(cmd, args.get());
-  cmd->callback([args] {
+  cmd->add_option("--annotate", *annotate_dir,
+                  "Also write DIR/frame_NNNNNN.png per frame: every rectangle candidate (grey), "
+                  "each red/green pair with its code (green) or why it was rejected (orange), "
+                  "the pose or the refusal");
+  cmd->add_flag("--annotate-refused", *annotate_refused,
+                "With --annotate: only the frames without a pose");
+  cmd->callback([args, annotate_dir, annotate_refused] {
     ReplaySetup setup;
     int rc = prepare_replay(*args, "locate", &setup);
     if (rc == kExitOk) {
       JsonLinesSink out(setup.localizer.mode);
-      PoseSink* sinks[] = {&out};
+      AnnotateSink annotate(*annotate_dir, *annotate_refused);
+      std::vector<PoseSink*> sinks{&out};
+      if (!annotate_dir->empty()) {
+        if (::mkdir(annotate_dir->c_str(), 0755) != 0 && errno != EEXIST) {
+          std::fprintf(stderr, "ceilposectl locate: --annotate %s: cannot create: %s\n",
+                       annotate_dir->c_str(), std::strerror(errno));
+          return set_exit_code(kExitFailure);
+        }
+        sinks.push_back(&annotate);
+      }
       rc = run_replay(*args, "locate", setup, sinks);
+      if (rc == kExitOk && !annotate.error().empty()) {
+        std::fprintf(stderr, "ceilposectl locate: %s\n", annotate.error().c_str());
+        rc = kExitFailure;
+      } else if (rc == kExitOk && !annotate_dir->empty()) {
+        std::fprintf(stderr, "locate: wrote %d annotated frames to %s\n", annotate.written(),
+                     annotate_dir->c_str());
+      }
     }
     std::fflush(stdout);
     set_exit_code(rc);

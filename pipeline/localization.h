@@ -36,6 +36,11 @@ struct Localization {
   // The decoded markers themselves (the survey's observations); valid until
   // the next frame is localized.
   std::span<const MarkerObservation> markers;
+  // The frame and the detection's intermediate results (rectangles, pairs
+  // and what became of each), for diagnostics such as `locate --annotate`;
+  // valid until the next frame is localized.
+  ImageView image;
+  const Pipeline* detection = nullptr;
   std::array<int64_t, kStageCount> stage_ns{};  // duration of each pipeline stage
   int64_t localize_ns = 0;                      // whole localization, filter included
 

@@ -27,6 +27,8 @@ const Localization& Localizer::localize(const ImageView& image, const FrameInfo&
   out_.frame = frame;
   out_.measured = result_->estimate;
   out_.markers_decoded = result_->marker_count;
+  out_.image = image;
+  out_.detection = &pipeline_;
   out_.markers = std::span<const MarkerObservation>(result_->markers.data(),
                                                     static_cast<size_t>(result_->marker_count));
   out_.stage_ns = result_->stage_ns;

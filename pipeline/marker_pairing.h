@@ -12,10 +12,22 @@
 
 namespace ceilpose {
 
+// What became of a pair once its dots were read (Pipeline sets it).
+enum class PairOutcome : uint8_t {
+  kDecoded,
+  kCut,           // touching the frame border
+  kBlurred,       // blur along North too wide for the red dots
+  kUnreadable,    // slots outside the frame
+  kAmbiguous,     // a slot too close to the dot threshold
+  kInconsistent,  // dark area disagreeing with the code
+  kOverflow,      // beyond kMaxMarkersPerFrame
+};
+
 struct MarkerPair {
   int red = -1;  // indices into the rectangle list
   int green = -1;
   double score = 0.0;  // sum of normalised deviations; 0 is a perfect pair
+  PairOutcome outcome = PairOutcome::kDecoded;
 };
 
 // Preallocates for `max_rectangles` rectangles; single-threaded.

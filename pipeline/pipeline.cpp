@@ -72,15 +72,14 @@ bool Pipeline::usable(const ImageView& frame) const {
   return frame.size_bytes == 0 || frame.size_bytes >= needed;
 }
 
-bool Pipeline::decode(const ImageView& frame, const MarkerPair& pair, MarkerRejects* rejects,
-                      MarkerObservation* out) {
+PairOutcome Pipeline::decode(const ImageView& frame, const MarkerPair& pair,
+                             MarkerObservation* out) {
   const RectangleCandidate& red = rects_[pair.red];
   const RectangleCandidate& green = rects_[pair.green];
   // A rectangle cut by the frame border has a shifted centroid, which puts
   // the slots off the dots: such a marker could only be misread.
   if (red.touches_border || green.touches_border) {
-    ++rejects->cut;
-    return false;
+    return PairOutcome::kCut;
   }
   const CeilingLayout& layout = config_.layout;
   const MarkerFrame m = marker_frame(red, green, layout);
@@ -90,25 +89,21 @@ bool Pipeline::decode(const ImageView& frame, const MarkerPair& pair, MarkerReje
   const double red_dot_px = layout.red_dot_n_m * px_per_m;
   const double blur_px = edge_spread_px(frame, m, true, layout);
   if (blur_px > config_.detector.max_blur_to_dot * red_dot_px) {
-    ++rejects->blurred;
-    return false;
+    return PairOutcome::kBlurred;
   }
   const float threshold = dot_threshold_ratio(config_.detector, blur_px, red_dot_px);
   const CodeReading code_i = read_code(frame, m, true, layout, config_.detector, threshold);
   const CodeReading code_j = read_code(frame, m, false, layout, config_.detector, threshold);
   if (!code_i.ok || !code_j.ok) {
-    ++rejects->unreadable;
-    return false;
+    return PairOutcome::kUnreadable;
   }
   if (std::min(code_i.margin, code_j.margin) < config_.detector.dot_min_margin) {
-    ++rejects->ambiguous;
-    return false;
+    return PairOutcome::kAmbiguous;
   }
   if (code_i.code >= layout.codes() || code_j.code >= layout.codes() ||
       !dark_area_consistent(red, code_i.code, true, layout, px_per_m) ||
       !dark_area_consistent(green, code_j.code, false, layout, px_per_m)) {
-    ++rejects->inconsistent;
-    return false;
+    return PairOutcome::kInconsistent;
   }
   MarkerObservation& o = *out;
   o.code_i = code_i.code;
@@ -142,7 +137,7 @@ bool Pipeline::decode(const ImageView& frame, const MarkerPair& pair, MarkerReje
   o.points[o.point_count++] = {0.0, 0.0, m.centre_u_px, m.centre_v_px};
   o.points[o.point_count++] = {layout.red_centre_e_m(), 0.0, red.cx, red.cy};
   o.points[o.point_count++] = {layout.green_centre_e_m(), 0.0, green.cx, green.cy};
-  return true;
+  return PairOutcome::kDecoded;
 }
 
 // With no marker decoded, the frame is refused for what stopped the pairs it
@@ -193,12 +188,12 @@ void Pipeline::process(const ImageView& frame, PositioningMode mode, FrameResult
 
   // 4. Read the dots, check the code against the geometry, emit points.
   for (size_t k = 0; k < pair_count_; ++k) {
-    if (out->marker_count == kMaxMarkersPerFrame) {
-      out->rejects.overflow += static_cast<int>(pair_count_ - k);
-      break;
-    }
-    if (decode(frame, pairs_[k], &out->rejects, &out->markers[out->marker_count]))
-      ++out->marker_count;
+    PairOutcome& outcome = pairs_[k].outcome;
+    outcome = out->marker_count == kMaxMarkersPerFrame
+                  ? PairOutcome::kOverflow
+                  : decode(frame, pairs_[k], &out->markers[out->marker_count]);
+    out->rejects.count(outcome);
+    if (outcome == PairOutcome::kDecoded) ++out->marker_count;
   }
   lap(kStageDecoding);
 

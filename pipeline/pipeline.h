@@ -30,8 +30,9 @@ enum PipelineStage : int {
   kStageCount
 };
 
-// Rectangle pairs of one frame that were not decoded, by reason. They decide
-// the frame's refusal when no marker decodes.
+// Rectangle pairs of one frame that were not decoded, by reason (each pair's
+// own is its MarkerPair::outcome). They decide the frame's refusal when no
+// marker decodes.
 struct MarkerRejects {
   int cut = 0;           // touching the frame border
   int blurred = 0;       // blur along North too wide for the red dots
@@ -40,6 +41,30 @@ struct MarkerRejects {
   int inconsistent = 0;  // dark area disagreeing with the code
   int overflow = 0;      // beyond kMaxMarkersPerFrame
   int total() const { return cut + blurred + unreadable + ambiguous + inconsistent + overflow; }
+  void count(PairOutcome outcome) {
+    switch (outcome) {
+      case PairOutcome::kDecoded:
+        break;
+      case PairOutcome::kCut:
+        ++cut;
+        break;
+      case PairOutcome::kBlurred:
+        ++blurred;
+        break;
+      case PairOutcome::kUnreadable:
+        ++unreadable;
+        break;
+      case PairOutcome::kAmbiguous:
+        ++ambiguous;
+        break;
+      case PairOutcome::kInconsistent:
+        ++inconsistent;
+        break;
+      case PairOutcome::kOverflow:
+        ++overflow;
+        break;
+    }
+  }
 };
 
 struct FrameResult {
@@ -80,8 +105,7 @@ class Pipeline {
 
  private:
   bool usable(const ImageView& frame) const;
-  bool decode(const ImageView& frame, const MarkerPair& pair, MarkerRejects* rejects,
-              MarkerObservation* out);
+  PairOutcome decode(const ImageView& frame, const MarkerPair& pair, MarkerObservation* out);
   static Refusal refusal_without_markers(const FrameResult& result, size_t pair_count);
 
   PipelineConfig config_;

@@ -297,6 +297,30 @@ TEST_F(LocateCommand, BadMapOrCameraFileExitsFourNamingTheFile) {
       << c.err;
 }
 
+TEST_F(LocateCommand, AnnotateWritesOnePictureOfWhatTheDetectorSawPerFrame) {
+  const std::vector<Pose2D> poses{{1.2, 1.5, 0.3}, {-20.0, -20.0, 0.0}, {2.0, 2.2, -2.0}};
+  const fs::path rec = record(poses);
+  const fs::path all = dir_ / "all", refused = dir_ / "refused";
+  const CommandRun r = run("locate --replay " + rec.string() + " --annotate " + all.string());
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NE(r.err.find("wrote 3 annotated frames"), std::string::npos) << r.err;
+  for (const char* name : {"frame_000000.png", "frame_000001.png", "frame_000002.png"}) {
+    const fs::path png = all / name;
+    ASSERT_TRUE(fs::exists(png)) << png;
+    std::ifstream in(png, std::ios::binary);
+    char magic[8] = {};
+    in.read(magic, 8);
+    EXPECT_EQ(std::string(magic + 1, 3), "PNG") << png;
+  }
+  const CommandRun only = run("locate --replay " + rec.string() + " --annotate " +
+                              refused.string() + " --annotate-refused");
+  ASSERT_EQ(only.exit_code, 0) << only.err;
+  EXPECT_TRUE(fs::exists(refused / "frame_000001.png"));
+  EXPECT_FALSE(fs::exists(refused / "frame_000000.png")) << "a frame with a pose was annotated";
+  // The JSON Lines are the same with or without pictures.
+  EXPECT_EQ(lines(only.out).size(), 3u);
+}
+
 TEST_F(LocateCommand, EvaluateScoresAgainstGroundTruth) {
   const fs::path rec = record({{1.2, 1.5, 0.3}, {2.0, 2.2, -2.0}, {-20.0, -20.0, 0.0}});
   const CommandRun r = run("evaluate --json --replay " + rec.string());
