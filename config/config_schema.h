@@ -160,8 +160,8 @@ void describe(V& v, ServiceConfig& c) {
   v.section("filter", [&] {
     FilterParams& f = p.filter;
     v.field("enabled", f.enabled);
-    v.field("accel_sigma_mps2", f.accel_sigma_mps2, 1e-6, 1000.0);
-    v.field("yaw_accel_sigma_radps2", f.yaw_accel_sigma_radps2, 1e-6, 1000.0);
+    v.field("jerk_sigma_mps3", f.jerk_sigma_mps3, 1e-6, 10000.0);
+    v.field("yaw_jerk_sigma_radps3", f.yaw_jerk_sigma_radps3, 1e-6, 10000.0);
     v.field("meas_sigma_floor_m", f.meas_sigma_floor_m, 0.0, 10.0);
     v.field("meas_sigma_floor_yaw_rad", f.meas_sigma_floor_yaw_rad, 0.0, kPi);
     v.field("gate_chi2", f.gate_chi2, 0.1, 1e6);
@@ -171,6 +171,9 @@ void describe(V& v, ServiceConfig& c) {
     v.field("predict_timeout_ms", f.predict_timeout_ms, 0.0, 60000.0);
     v.field("init_velocity_sigma_mps", f.init_velocity_sigma_mps, 1e-6, 100.0);
     v.field("init_yaw_rate_sigma_radps", f.init_yaw_rate_sigma_radps, 1e-6, 100.0);
+    v.field("init_accel_sigma_mps2", f.init_accel_sigma_mps2, 1e-6, 1000.0);
+    v.field("init_yaw_accel_sigma_radps2", f.init_yaw_accel_sigma_radps2, 1e-6, 1000.0);
+    v.field("predict_horizon_ms", f.predict_horizon_ms, 0.0, 10000.0);
   });
   v.section("capture", [&] {
     CaptureConfig& k = c.capture;

@@ -2,10 +2,13 @@
 // JSON object per frame (SPEC §5).
 #include <sys/stat.h>
 
+#include <array>
 #include <cerrno>
 #include <cinttypes>
+#include <cmath>
 #include <cstdio>
 #include <cstring>
+#include <optional>
 #include <vector>
 
 #include "core/json_text.h"
@@ -21,7 +24,8 @@ namespace {
 // the estimate makes.
 class JsonLinesSink final : public PoseSink {
  public:
-  explicit JsonLinesSink(PositioningMode requested) : requested_(requested) {}
+  JsonLinesSink(PositioningMode requested, std::optional<double> predict_ms)
+      : requested_(requested), predict_ms_(predict_ms) {}
 
   void consume(const Localization& loc) override {
     const PoseEstimate& e = loc.published;
@@ -29,27 +33,44 @@ class JsonLinesSink final : public PoseSink {
     // An invalid frame names the mode that was asked for: none was used.
     const std::string_view mode = to_string(e.valid ? e.mode : requested_);
     if (e.valid) {
+      Pose2D pose = e.pose;
+      std::array<double, 9> cov = e.covariance;
+      MotionState motion = loc.motion.state;
+      if (loc.motion.valid && predict_ms_) {
+        motion = motion_at(loc.motion, loc.frame.timestamp_ns + std::llround(*predict_ms_ * 1e6));
+        pose = {motion.x[0], motion.x[1], motion.x[2]};
+        for (int r = 0; r < 3; ++r)
+          for (int c = 0; c < 3; ++c) cov[r * 3 + c] = motion.p[r * kMotionStates + c];
+      }
       std::printf("{\"index\":%" PRId64 ",\"timestamp_ns\":%" PRId64
                   ",\"valid\":true,\"x_m\":%.7f,\"y_m\":%.7f,\"yaw_rad\":%.7f,\"mode\":\"%.*s\","
                   "\"markers\":%d,\"proc_us\":%" PRId64
-                  ",\"refusal\":null,\"rms_px\":%.3f,\"cov\":[%.3e,%.3e,%.3e,%.3e,%.3e,%.3e]}\n",
-                  loc.frame.index, loc.frame.timestamp_ns, e.pose.x_m, e.pose.y_m,
-                  printable_yaw_rad(e.pose.yaw_rad, 7), static_cast<int>(mode.size()), mode.data(),
-                  e.markers, proc_us, e.rms_residual_px, e.covariance[0], e.covariance[1],
-                  e.covariance[2], e.covariance[4], e.covariance[5], e.covariance[8]);
+                  ",\"refusal\":null,\"rms_px\":%.3f,\"cov\":[%.3e,%.3e,%.3e,%.3e,%.3e,%.3e]",
+                  loc.frame.index, loc.frame.timestamp_ns, pose.x_m, pose.y_m,
+                  printable_yaw_rad(pose.yaw_rad, 7), static_cast<int>(mode.size()), mode.data(),
+                  e.markers, proc_us, e.rms_residual_px, cov[0], cov[1], cov[2], cov[4], cov[5],
+                  cov[8]);
+      if (loc.motion.valid)
+        std::printf(",\"vx_mps\":%.6f,\"vy_mps\":%.6f,\"yaw_rate_radps\":%.6f", motion.x[3],
+                    motion.x[4], motion.x[5]);
+      if (predict_ms_) std::printf(",\"predict_ms\":%.3f", *predict_ms_);
+      std::fputs("}\n", stdout);
     } else {
       const std::string_view refusal = to_string(e.refusal);
       std::printf("{\"index\":%" PRId64 ",\"timestamp_ns\":%" PRId64
                   ",\"valid\":false,\"x_m\":null,\"y_m\":null,\"yaw_rad\":null,\"mode\":\"%.*s\","
-                  "\"markers\":%d,\"proc_us\":%" PRId64 ",\"refusal\":\"%.*s\"}\n",
+                  "\"markers\":%d,\"proc_us\":%" PRId64 ",\"refusal\":\"%.*s\"",
                   loc.frame.index, loc.frame.timestamp_ns, static_cast<int>(mode.size()),
                   mode.data(), e.markers, proc_us, static_cast<int>(refusal.size()),
                   refusal.data());
+      if (predict_ms_) std::printf(",\"predict_ms\":%.3f", *predict_ms_);
+      std::fputs("}\n", stdout);
     }
   }
 
  private:
   PositioningMode requested_;
+  std::optional<double> predict_ms_;
 };
 
 void add_locate_command(CLI::App& app) {
@@ -62,7 +83,9 @@ void add_locate_command(CLI::App& app) {
       "frame on stdout (SPEC §5): index, timestamp_ns, valid, x_m, y_m, yaw_rad (null when "
       "invalid), mode, markers, proc_us, refusal (why an invalid frame has no pose, e.g. "
       "no_markers, wrong_heights; null when valid), and for valid frames rms_px and cov (the "
-      "upper triangle of the (x, y, yaw) covariance: xx, xy, xyaw, yy, yyaw, yawyaw). Errors "
+      "upper triangle of the (x, y, yaw) covariance: xx, xy, xyaw, yy, yyaw, yawyaw); with "
+      "--filter also vx_mps, vy_mps (world frame) and yaw_rate_radps, with --predict-ms MS the "
+      "pose, covariance and velocity predicted MS ms past the frame and predict_ms. Errors "
       "on stderr; exit 4 for a malformed recording or configuration, 2 for usage.");
   add_replay_options(cmd, args.get());
   cmd->add_option("--annotate", *annotate_dir,
@@ -75,7 +98,7 @@ void add_locate_command(CLI::App& app) {
     ReplaySetup setup;
     int rc = prepare_replay(*args, "locate", &setup);
     if (rc == kExitOk) {
-      JsonLinesSink out(setup.localizer.mode);
+      JsonLinesSink out(setup.localizer.mode, args->predict_ms);
       AnnotateSink annotate(*annotate_dir, *annotate_refused);
       std::vector<PoseSink*> sinks{&out};
       if (!annotate_dir->empty()) {

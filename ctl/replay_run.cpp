@@ -52,6 +52,11 @@ void add_replay_options(CLI::App* cmd, ReplayArgs* args) {
   add_calibration_options(cmd, &args->calibration);
   cmd->add_flag("--filter", args->filter,
                 "Apply the daemon's temporal filter (default: every frame solved on its own)");
+  cmd->add_option("--predict-ms", args->predict_ms,
+                  "With the filter (implied): predict each pose MS milliseconds past its frame's "
+                  "time, as a controller asking \"where am I now?\" gets when the frame is MS "
+                  "old (SPEC §5)")
+      ->check(CLI::Range(-10000.0, 10000.0));
   cmd->add_option("--mode", args->mode_text, "Positioning mode: auto | axes | barycentric | lsq")
       ->check(CLI::IsMember(positioning_mode_names()));
   cmd->add_option("--decode-threads", args->decode_threads,
@@ -81,7 +86,7 @@ int prepare_replay(const ReplayArgs& args, const char* command, ReplaySetup* set
                  args.mode_text.c_str(), positioning_mode_list().c_str());
     return kExitUsage;
   }
-  setup->localizer = LocalizerOptions{mode, args.filter};
+  setup->localizer = LocalizerOptions{mode, args.filter || args.predict_ms.has_value()};
   auto reader = RecordingReader::open(args.dir);
   if (!reader.ok()) {
     std::fprintf(stderr, "ceilposectl %s: %s\n", command, reader.error().message.c_str());

@@ -22,10 +22,14 @@ struct ReplayArgs {
   CalibrationFiles calibration;  // --camera, --map: over the configuration's
   std::string mode_text;         // empty: the configuration's mode (SPEC default auto)
   bool filter = false;
+  // --predict-ms (implies --filter): how far past each frame's time the pose
+  // is predicted; unset without the option.
+  std::optional<double> predict_ms;
   int decode_threads = FramePrefetcher::default_threads();
 };
 
-// Adds --replay, --config, --camera, --map, --filter, --mode and --decode-threads.
+// Adds --replay, --config, --camera, --map, --filter, --predict-ms, --mode and
+// --decode-threads.
 void add_replay_options(CLI::App* cmd, ReplayArgs* args);
 
 struct ReplaySetup {

@@ -12,13 +12,6 @@ constexpr double kWithinUnits = 0.05;  // SPEC §6 thesis criterion
 constexpr double kGrossUnits = 0.25;
 constexpr double kGrossYawRad = 5.0 * std::numbers::pi / 180.0;
 
-// Nearest-rank percentile of a sorted sample.
-double percentile(const std::vector<double>& sorted, double p) {
-  if (sorted.empty()) return 0.0;
-  const size_t rank = static_cast<size_t>(std::ceil(p * static_cast<double>(sorted.size())));
-  return sorted[std::clamp<size_t>(rank, 1, sorted.size()) - 1];
-}
-
 // e^T C^-1 e for a 3x3 symmetric covariance; negative when C is singular.
 double nees(const std::array<double, 9>& c, double ex, double ey, double eyaw) {
   const double a = c[0], b = c[1], d = c[2], e = c[4], f = c[5], g = c[8];
@@ -32,6 +25,12 @@ double nees(const std::array<double, 9>& c, double ex, double ey, double eyaw) {
 }
 
 }  // namespace
+
+double percentile(const std::vector<double>& sorted, double p) {
+  if (sorted.empty()) return 0.0;
+  const size_t rank = static_cast<size_t>(std::ceil(p * static_cast<double>(sorted.size())));
+  return sorted[std::clamp<size_t>(rank, 1, sorted.size()) - 1];
+}
 
 void AccuracyAccumulator::add(const Pose2D& truth, bool whole, const PoseEstimate& est) {
   ++counts_.frames;

@@ -15,6 +15,9 @@
 
 namespace ceilpose {
 
+// Nearest-rank percentile (p in [0, 1]) of an ascending sample; 0 when empty.
+double percentile(const std::vector<double>& sorted, double p);
+
 struct AccuracyReport {
   int frames = 0;               // frames with ground truth
   int frames_with_whole = 0;    // ... of which with ≥ 1 whole marker in view

@@ -7,6 +7,7 @@
 #include <span>
 
 #include "core/fix_state.h"
+#include "core/motion_model.h"
 #include "core/pose.h"
 #include "core/refusal.h"
 #include "pipeline/pipeline.h"
@@ -27,6 +28,9 @@ struct Localization {
   PoseEstimate measured;   // this frame solved on its own
   PoseEstimate published;  // what to publish: the filter's output, or `measured` unfiltered
   bool filtered = false;   // `published` came from the temporal filter
+  // The filter's full state at the frame's time (valid with a valid filtered
+  // pose): velocity, acceleration and what prediction needs.
+  MotionEstimate motion;
   FixState fix = FixState::kNone;
   // Why this frame gave no measurement (kNone when it did; kFilterRejected
   // when it did but the filter refused it). published.refusal says why the

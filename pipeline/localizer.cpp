@@ -41,6 +41,12 @@ const Localization& Localizer::localize(const ImageView& image, const FrameInfo&
     out_.published.refusal = out_.measured.valid ? Refusal::kFilterRejected : out_.measured.refusal;
   }
   out_.refusal = out_.measured.valid ? out_.published.refusal : out_.measured.refusal;
+  out_.motion.valid = options_.filter && out_.published.valid && filter_.initialised();
+  if (out_.motion.valid) {
+    out_.motion.time_ns = filter_.state_time_ns();
+    out_.motion.state = filter_.state();
+    out_.motion.jerk = filter_.jerk_density();
+  }
 
   // 3. Fix state.
   if (out_.measured.valid && out_.published.valid) {

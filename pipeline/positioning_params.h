@@ -98,18 +98,22 @@ struct PositioningParams {
 
 struct FilterParams {
   bool enabled = true;  // the daemon filters; `locate` only with --filter
-  // White-acceleration process noise of the constant-velocity model:
-  // standard deviation of the acceleration, m/s² and rad/s². Larger follows
-  // manoeuvres faster but smooths less. Sized for the sim's patrol (1.2 m/s,
-  // stepping into 2 rad/s U-turns): at 0.5 / 1 the filter lagged by up to 6 cm
-  // and 15° there and gated good measurements; at 3 / 20 it lags < 1 mm.
-  double accel_sigma_mps2 = 3.0;
-  double yaw_accel_sigma_radps2 = 20.0;
+  // White-jerk process noise of the constant-acceleration model
+  // (core/motion_model.h): square root of the jerk's spectral density,
+  // m/s³·√s and rad/s³·√s. Larger follows changes of acceleration faster but
+  // smooths less. Tuned on the `drive` set (curves, 0.1-1.5 m/s) and the
+  // patrol, whose U-turns start at 2 rad/s at once: at a yaw jerk of 30 the
+  // filter gated the turns' first frames and lagged 10 mm; docs/latency.md
+  // has the sweep.
+  double jerk_sigma_mps3 = 10.0;
+  double yaw_jerk_sigma_radps3 = 300.0;
   // Measurement standard deviation floors, metres / radians: a measurement's
-  // own covariance is used but never taken as better than this (lsq can
-  // report sub-millimetre, but model errors are not in it).
-  double meas_sigma_floor_m = 0.002;
-  double meas_sigma_floor_yaw_rad = 0.003;
+  // own covariance is used but never taken as better than this. lsq's
+  // covariance is honest now (mean NEES ~3) so the floors are small: at 2 mm
+  // the filter trusted its prediction over 0.1 mm measurements and lagged
+  // 10 mm on curves.
+  double meas_sigma_floor_m = 0.0002;
+  double meas_sigma_floor_yaw_rad = 0.0005;
   // Gate on the squared Mahalanobis distance of the innovation (3 DOF).
   // 16.3 is the 99.9% point of chi²(3); raise to accept faster motion.
   double gate_chi2 = 16.3;
@@ -127,6 +131,12 @@ struct FilterParams {
   // Initial velocity standard deviations, m/s and rad/s.
   double init_velocity_sigma_mps = 0.5;
   double init_yaw_rate_sigma_radps = 1.0;
+  // Initial acceleration standard deviations, m/s² and rad/s².
+  double init_accel_sigma_mps2 = 1.0;
+  double init_yaw_accel_sigma_radps2 = 3.0;
+  // How far ahead (or back) of a pose's frame the pose client predicts
+  // (ceilpose_client_predict, `pose --at`) before it refuses, milliseconds.
+  double predict_horizon_ms = 200.0;
 };
 
 // True when a measured depth scale (PoseEstimate::depth_scale, 0 = not

@@ -29,56 +29,54 @@ void TemporalFilter::reset() {
   consecutive_gated_ = 0;
 }
 
+JerkDensity TemporalFilter::jerk_density() const {
+  const double j = params_.jerk_sigma_mps3, yj = params_.yaw_jerk_sigma_radps3;
+  return {j * j, j * j, yj * yj};
+}
+
 void TemporalFilter::initialise(const PoseEstimate& m, int64_t timestamp_ns) {
-  state_ = {m.pose.x_m, m.pose.y_m, m.pose.yaw_rad, 0.0, 0.0, 0.0};
-  cov_.fill(0.0);
+  state_.x.fill(0.0);
+  state_.x[0] = m.pose.x_m;
+  state_.x[1] = m.pose.y_m;
+  state_.x[2] = m.pose.yaw_rad;
+  std::array<double, kN* kN>& p = state_.p;
+  p.fill(0.0);
   for (int r = 0; r < 3; ++r)
-    for (int c = 0; c < 3; ++c) cov_[r * kN + c] = m.covariance[r * 3 + c];
+    for (int c = 0; c < 3; ++c) p[r * kN + c] = m.covariance[r * 3 + c];
   const double floor_m2 = params_.meas_sigma_floor_m * params_.meas_sigma_floor_m;
   const double floor_rad2 = params_.meas_sigma_floor_yaw_rad * params_.meas_sigma_floor_yaw_rad;
-  cov_[0 * kN + 0] = std::max(cov_[0 * kN + 0], floor_m2);
-  cov_[1 * kN + 1] = std::max(cov_[1 * kN + 1], floor_m2);
-  cov_[2 * kN + 2] = std::max(cov_[2 * kN + 2], floor_rad2);
-  const double v2 = params_.init_velocity_sigma_mps * params_.init_velocity_sigma_mps;
-  cov_[3 * kN + 3] = cov_[4 * kN + 4] = v2;
-  cov_[5 * kN + 5] = params_.init_yaw_rate_sigma_radps * params_.init_yaw_rate_sigma_radps;
+  p[0 * kN + 0] = std::max(p[0 * kN + 0], floor_m2);
+  p[1 * kN + 1] = std::max(p[1 * kN + 1], floor_m2);
+  p[2 * kN + 2] = std::max(p[2 * kN + 2], floor_rad2);
+  const double sigma[kN] = {0.0,
+                            0.0,
+                            0.0,
+                            params_.init_velocity_sigma_mps,
+                            params_.init_velocity_sigma_mps,
+                            params_.init_yaw_rate_sigma_radps,
+                            params_.init_accel_sigma_mps2,
+                            params_.init_accel_sigma_mps2,
+                            params_.init_yaw_accel_sigma_radps2};
+  for (int i = 3; i < kN; ++i) p[i * kN + i] = sigma[i] * sigma[i];
   initialised_ = true;
   last_ns_ = last_measurement_ns_ = timestamp_ns;
   consecutive_gated_ = 0;
   last_mode_ = m.mode;
 }
 
-// Constant velocity with white acceleration noise (discrete): per axis
-// F = [[1, dt], [0, 1]], Q = σa²·[[dt⁴/4, dt³/2], [dt³/2, dt²]].
 void TemporalFilter::predict(double dt) {
   if (dt <= 0.0) return;
-  for (int a = 0; a < 3; ++a) state_[a] += dt * state_[a + 3];
-  state_[2] = wrap_angle_rad(state_[2]);
-  // P ← F P Fᵀ with F = I + dt·E, E mapping velocity i+3 into position i.
-  std::array<double, kN* kN> fp = cov_;
-  for (int a = 0; a < 3; ++a)
-    for (int c = 0; c < kN; ++c) fp[a * kN + c] += dt * cov_[(a + 3) * kN + c];
-  std::array<double, kN* kN> p = fp;
-  for (int r = 0; r < kN; ++r)
-    for (int a = 0; a < 3; ++a) p[r * kN + a] += dt * fp[r * kN + a + 3];
-  const double sigma[3] = {params_.accel_sigma_mps2, params_.accel_sigma_mps2,
-                           params_.yaw_accel_sigma_radps2};
-  for (int a = 0; a < 3; ++a) {
-    const double s2 = sigma[a] * sigma[a];
-    p[a * kN + a] += s2 * dt * dt * dt * dt / 4.0;
-    p[a * kN + a + 3] += s2 * dt * dt * dt / 2.0;
-    p[(a + 3) * kN + a] += s2 * dt * dt * dt / 2.0;
-    p[(a + 3) * kN + a + 3] += s2 * dt * dt;
-  }
-  cov_ = p;
+  const MotionState before = state_;
+  propagate_motion(before, dt, jerk_density(), &state_);
+  state_.x[2] = wrap_angle_rad(state_.x[2]);
 }
 
 PoseEstimate TemporalFilter::output(const PoseEstimate* used) const {
   PoseEstimate out;
   out.valid = true;
-  out.pose = {state_[0], state_[1], wrap_angle_rad(state_[2])};
+  out.pose = {state_.x[0], state_.x[1], wrap_angle_rad(state_.x[2])};
   for (int r = 0; r < 3; ++r)
-    for (int c = 0; c < 3; ++c) out.covariance[r * 3 + c] = cov_[r * kN + c];
+    for (int c = 0; c < 3; ++c) out.covariance[r * 3 + c] = state_.p[r * kN + c];
   out.mode = used != nullptr ? used->mode : last_mode_;
   out.markers = used != nullptr ? used->markers : 0;
   out.rms_residual_px = used != nullptr ? used->rms_residual_px : 0.0;
@@ -90,7 +88,8 @@ PoseEstimate TemporalFilter::output(const PoseEstimate* used) const {
 // False when S is singular.
 bool TemporalFilter::innovation(const PoseEstimate& m, std::array<double, 3>* y,
                                 std::array<double, 9>* s_inv) const {
-  *y = {m.pose.x_m - state_[0], m.pose.y_m - state_[1], wrap_angle_rad(m.pose.yaw_rad - state_[2])};
+  *y = {m.pose.x_m - state_.x[0], m.pose.y_m - state_.x[1],
+        wrap_angle_rad(m.pose.yaw_rad - state_.x[2])};
   std::array<double, 9> r = m.covariance;
   const double floor_m2 = params_.meas_sigma_floor_m * params_.meas_sigma_floor_m;
   const double floor_rad2 = params_.meas_sigma_floor_yaw_rad * params_.meas_sigma_floor_yaw_rad;
@@ -99,7 +98,7 @@ bool TemporalFilter::innovation(const PoseEstimate& m, std::array<double, 3>* y,
   r[8] = std::max(r[8], floor_rad2);
   std::array<double, 9> s{};
   for (int i = 0; i < 3; ++i)
-    for (int j = 0; j < 3; ++j) s[i * 3 + j] = cov_[i * kN + j] + r[i * 3 + j];
+    for (int j = 0; j < 3; ++j) s[i * 3 + j] = state_.p[i * kN + j] + r[i * 3 + j];
   return invert3(s, s_inv);
 }
 
@@ -115,29 +114,29 @@ bool TemporalFilter::gated(const std::array<double, 3>& y,
   return d2 > params_.gate_chi2 && !small;
 }
 
-// K = P H^T S^-1 (6x3); x += K y; P -= K H P, kept symmetric.
+// K = P H^T S^-1 (9x3); x += K y; P -= K H P, kept symmetric.
 void TemporalFilter::correct(const std::array<double, 3>& y, const std::array<double, 9>& s_inv) {
   std::array<double, kN * 3> k{};
   for (int i = 0; i < kN; ++i)
     for (int j = 0; j < 3; ++j) {
       double sum = 0.0;
-      for (int l = 0; l < 3; ++l) sum += cov_[i * kN + l] * s_inv[l * 3 + j];
+      for (int l = 0; l < 3; ++l) sum += state_.p[i * kN + l] * s_inv[l * 3 + j];
       k[i * 3 + j] = sum;
     }
   for (int i = 0; i < kN; ++i)
-    for (int j = 0; j < 3; ++j) state_[i] += k[i * 3 + j] * y[j];
-  state_[2] = wrap_angle_rad(state_[2]);
-  std::array<double, kN* kN> p = cov_;
+    for (int j = 0; j < 3; ++j) state_.x[i] += k[i * 3 + j] * y[j];
+  state_.x[2] = wrap_angle_rad(state_.x[2]);
+  std::array<double, kN* kN> p = state_.p;
   for (int i = 0; i < kN; ++i)
     for (int c = 0; c < kN; ++c) {
       double sum = 0.0;
-      for (int j = 0; j < 3; ++j) sum += k[i * 3 + j] * cov_[j * kN + c];
+      for (int j = 0; j < 3; ++j) sum += k[i * 3 + j] * state_.p[j * kN + c];
       p[i * kN + c] -= sum;
     }
   for (int i = 0; i < kN; ++i)  // against round-off
     for (int c = i + 1; c < kN; ++c)
       p[i * kN + c] = p[c * kN + i] = 0.5 * (p[i * kN + c] + p[c * kN + i]);
-  cov_ = p;
+  state_.p = p;
 }
 
 PoseEstimate TemporalFilter::update(const PoseEstimate& m, int64_t timestamp_ns) {

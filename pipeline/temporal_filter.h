@@ -1,10 +1,13 @@
 #pragma once
-// Temporal filter of the daemon: a constant-velocity Kalman filter on
-// (x, y, yaw) with yaw wrapping, gating of jumps, counted re-initialisation
-// and prediction through missing frames up to a timeout.
+// Temporal filter of the daemon: a Kalman filter on (x, y, yaw) with the
+// constant-acceleration model of core/motion_model.h, yaw wrapping, gating of
+// jumps, counted re-initialisation and prediction through missing frames up
+// to a timeout. Its state (pose, rates, accelerations and their covariance)
+// is what the pose client extrapolates from.
 #include <array>
 #include <cstdint>
 
+#include "core/motion_model.h"
 #include "pipeline/pose_estimate.h"
 #include "pipeline/positioning_params.h"
 
@@ -32,9 +35,14 @@ class TemporalFilter {
   void reset();
 
   const FilterStats& stats() const { return stats_; }
+  // The state at the last update's timestamp; meaningful while initialised().
+  bool initialised() const { return initialised_; }
+  const MotionState& state() const { return state_; }
+  int64_t state_time_ns() const { return last_ns_; }
+  JerkDensity jerk_density() const;
 
  private:
-  static constexpr int kN = 6;  // x, y, yaw, vx, vy, vyaw
+  static constexpr int kN = kMotionStates;
   void initialise(const PoseEstimate& measurement, int64_t timestamp_ns);
   void predict(double dt_s);
   bool innovation(const PoseEstimate& m, std::array<double, 3>* y,
@@ -46,8 +54,7 @@ class TemporalFilter {
   FilterParams params_;
   FilterStats stats_;
   bool initialised_ = false;
-  std::array<double, kN> state_{};
-  std::array<double, kN * kN> cov_{};
+  MotionState state_;
   int64_t last_ns_ = 0;              // time the state refers to
   int64_t last_measurement_ns_ = 0;  // last fused (or initialising) measurement
   int consecutive_gated_ = 0;

@@ -80,6 +80,12 @@ Result<ScenarioFrame> trajectory(Context& c) {
   return f;
 }
 
+Result<ScenarioFrame> drive(Context& c) {
+  ScenarioFrame f = at(drive_pose(c.options.layout, c.index * (kScenarioFramePeriod_ns * 1e-9)));
+  f.effects.read_noise_sigma = 2.0;
+  return f;
+}
+
 // Most sets are uniform random poses over the grid with one kind of effect;
 // they differ only in how they set the effects.
 void clean(Context&, Effects&) {}
@@ -255,7 +261,7 @@ Result<ScenarioFrame> mount_drive(Context& c) {
   return fr;
 }
 
-constexpr std::array<Entry, 20> kEntries{{
+constexpr std::array<Entry, 21> kEntries{{
     {"thesis_points",
      "the thesis's static test points (1.5,1.5) (1.5,2.0) (1.5,2.5) (2.0,2.5) (2.5,2.5) grid "
      "units, frames split evenly between them, random yaw, read noise 2",
@@ -268,6 +274,10 @@ constexpr std::array<Entry, 20> kEntries{{
      "patrol loop over the grid at 1.2 m/s (lanes joined by U-turns of one grid unit radius), 30 "
      "fps, read noise 2",
      &trajectory, nullptr},
+    {"drive",
+     "a curving drive around the grid centre (curve radius 0.35 m and up), heading along the path, "
+     "speed swinging smoothly between 0.1 and 1.5 m/s every 9 s, 30 fps, read noise 2",
+     &drive, nullptr},
     {"gain", "random poses, exposure gain 0.45-1.6 (auto-exposure)", nullptr, &gain},
     {"gradient", "random poses, illumination gradient 20-60% in a random direction", nullptr,
      &gradient},

@@ -75,3 +75,58 @@ Pose2D trajectory_pose(const CeilingLayout& layout, double t_s) {
 }
 
 }  // namespace ceilpose::sim
+
+namespace ceilpose::sim {
+namespace {
+
+// The drive's path around the grid centre, metres, as a function of the
+// parameter u in [0, 2π): a figure of eight bent by a third harmonic per
+// axis, curves of 0.35 m radius and up on the default grid, no cusp.
+struct DrivePath {
+  double cx_m, cy_m, scale;
+  void at(double u, double* x_m, double* y_m) const {
+    *x_m = cx_m + scale * (1.45 * std::sin(u) - 0.20 * std::sin(3.0 * u));
+    *y_m = cy_m + scale * (1.15 * std::sin(2.0 * u + 0.3) + 0.10 * std::cos(3.0 * u));
+  }
+};
+
+constexpr int kDriveSamples = 16384;
+
+}  // namespace
+
+Pose2D drive_pose(const CeilingLayout& layout, double t_s) {
+  const double span_m = (layout.codes() - 1) * layout.grid_m;
+  // Sized for the default 8 x 8 grid (span 4.27 m); smaller grids shrink it.
+  const DrivePath path{0.5 * span_m, 0.5 * span_m, std::min(1.0, span_m / 4.267)};
+  // Arc length along u, tabulated once per call (never on a hot path): the
+  // speed profile is given in metres per second, not in u per second.
+  std::vector<double> arc_m(kDriveSamples + 1, 0.0);
+  double px = 0.0, py = 0.0;
+  path.at(0.0, &px, &py);
+  for (int k = 1; k <= kDriveSamples; ++k) {
+    double x = 0.0, y = 0.0;
+    path.at(2.0 * kPi * k / kDriveSamples, &x, &y);
+    arc_m[k] = arc_m[k - 1] + std::hypot(x - px, y - py);
+    px = x;
+    py = y;
+  }
+  // Speed between kDriveMinSpeed_mps and kDriveMaxSpeed_mps, one period
+  // every kDriveSpeedPeriod_s: s(t) = ∫ v.
+  const double mean = 0.5 * (kDriveMinSpeed_mps + kDriveMaxSpeed_mps);
+  const double amp = 0.5 * (kDriveMaxSpeed_mps - kDriveMinSpeed_mps);
+  const double w = 2.0 * kPi / kDriveSpeedPeriod_s;
+  double s_m = std::fmod(mean * t_s - amp / w * std::sin(w * t_s), arc_m.back());
+  if (s_m < 0.0) s_m += arc_m.back();
+  const auto it = std::upper_bound(arc_m.begin(), arc_m.end(), s_m);
+  const int k = std::clamp(static_cast<int>(it - arc_m.begin()) - 1, 0, kDriveSamples - 1);
+  const double f = (s_m - arc_m[k]) / std::max(1e-12, arc_m[k + 1] - arc_m[k]);
+  const double u = 2.0 * kPi * (k + f) / kDriveSamples;
+  double x = 0.0, y = 0.0, xa = 0.0, ya = 0.0, xb = 0.0, yb = 0.0;
+  path.at(u, &x, &y);
+  path.at(u - 1e-6, &xa, &ya);
+  path.at(u + 1e-6, &xb, &yb);
+  // The robot drives forwards: its heading is the path's tangent.
+  return {x, y, std::atan2(yb - ya, xb - xa)};
+}
+
+}  // namespace ceilpose::sim

@@ -32,7 +32,8 @@ int accuracy_frames(int release_frames) {
 }
 
 AccuracyReport run_scenario(const std::string& name, int frames, uint64_t seed,
-                            PositioningMode mode, bool filter, const PipelineConfig& config) {
+                            PositioningMode mode, bool filter, const PipelineConfig& config,
+                            PoseSink* also) {
   sim::SceneOptions options{config.layout, config.intrinsics, seed, nullptr};
   auto scenario = sim::make_scenario(name, options, frames, seed);
   if (!scenario.ok()) {
@@ -55,7 +56,9 @@ AccuracyReport run_scenario(const std::string& name, int frames, uint64_t seed,
     info.timestamp_ns = f.timestamp_ns;
     info.has_ground_truth = true;
     info.ground_truth = f.pose;
-    accuracy.consume(localizer.localize(image.view(), info));
+    const Localization& loc = localizer.localize(image.view(), info);
+    accuracy.consume(loc);
+    if (also != nullptr) also->consume(loc);
   }
   return accuracy.report();
 }

@@ -7,6 +7,7 @@
 #include "pipeline/accuracy_metrics.h"
 #include "pipeline/pipeline_config.h"
 #include "pipeline/pose_estimate.h"
+#include "pipeline/pose_sink.h"
 
 namespace ceilpose::testing {
 
@@ -16,10 +17,11 @@ int accuracy_frames(int release_frames);
 
 // Renders `frames` frames of scenario `name` (sim/scenarios.h) with `seed`
 // and localizes them with `config` in `mode`, through the daemon's temporal
-// filter when `filter`. Fails the calling test (and returns an empty report)
-// if the scenario cannot be made.
+// filter when `filter`; `also` (if given) sees every frame too. Fails the calling test (and returns
+// an empty report) if the scenario cannot be made.
 AccuracyReport run_scenario(const std::string& name, int frames, uint64_t seed,
                             PositioningMode mode, bool filter = false,
-                            const PipelineConfig& config = PipelineConfig{});
+                            const PipelineConfig& config = PipelineConfig{},
+                            PoseSink* also = nullptr);
 
 }  // namespace ceilpose::testing

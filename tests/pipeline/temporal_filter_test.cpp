@@ -32,7 +32,7 @@ TEST(TemporalFilter, InvalidUntilFirstValidMeasurement) {
 
 TEST(TemporalFilter, SmoothsNoiseOfAStationaryRobot) {
   FilterParams params;  // process noise of a slow robot: smoothing dominates
-  params.accel_sigma_mps2 = 0.5;
+  params.jerk_sigma_mps3 = 0.05;
   TemporalFilter filter{params};
   std::mt19937_64 rng(7);
   std::normal_distribution<double> noise(0.0, 0.005);
@@ -59,6 +59,35 @@ TEST(TemporalFilter, TracksConstantVelocityWithoutLag) {
   }
   const double t_end = 119 * kFrameNs * 1e-9;
   EXPECT_NEAR(out.pose.x_m, 0.5 * t_end, 0.002);
+}
+
+// A robot speeding up on a circle: the constant-acceleration model follows
+// it without lag and its state carries the velocity, yaw rate and the
+// centripetal acceleration a controller's prediction needs.
+TEST(TemporalFilter, FollowsAnAcceleratingTurnAndEstimatesItsVelocity) {
+  TemporalFilter filter{FilterParams{}};
+  const double radius_m = 1.0;
+  auto angle = [](double t) { return 0.2 * t + 0.25 * t * t; };  // speeds up
+  PoseEstimate out;
+  for (int k = 0; k < 90; ++k) {
+    const double t = k * kFrameNs * 1e-9, a = angle(t);
+    out = filter.update(measurement(radius_m * std::cos(a), radius_m * std::sin(a),
+                                    a + std::numbers::pi / 2, 0.0002),
+                        k * kFrameNs);
+  }
+  const double t = 89 * kFrameNs * 1e-9, a = angle(t), w = 0.2 + 0.5 * t;  // 1.68 rad/s
+  ASSERT_TRUE(out.valid);
+  EXPECT_NEAR(out.pose.x_m, radius_m * std::cos(a), 0.0005);
+  EXPECT_NEAR(out.pose.y_m, radius_m * std::sin(a), 0.0005);
+  const MotionState& s = filter.state();
+  EXPECT_NEAR(s.x[3], -radius_m * w * std::sin(a), 0.01);
+  EXPECT_NEAR(s.x[4], radius_m * w * std::cos(a), 0.01);
+  EXPECT_NEAR(s.x[5], w, 0.01);
+  // Centripetal acceleration w²r towards the centre (plus the tangential 0.5 m/s²).
+  EXPECT_NEAR(s.x[6], -radius_m * w * w * std::cos(a) - 0.5 * std::sin(a), 0.2);
+  EXPECT_NEAR(s.x[7], -radius_m * w * w * std::sin(a) + 0.5 * std::cos(a), 0.2);
+  EXPECT_EQ(filter.stats().gated, 0u);
+  EXPECT_EQ(filter.state_time_ns(), 89 * kFrameNs);
 }
 
 TEST(TemporalFilter, WrapsYawAcrossPi) {

@@ -1,0 +1,93 @@
+#pragma once
+// The robot's motion model, shared by the daemon's temporal filter and the
+// pose client's prediction so that "where am I at t" has one answer: constant
+// acceleration on x, y and yaw, driven by white jerk.
+//
+// State order (index = order * 3 + axis): x_m, y_m, yaw_rad, vx_mps, vy_mps,
+// yaw_rate_radps, ax_mps2, ay_mps2, yaw_accel_radps2; world frame. Chosen over
+// constant velocity because a robot on a curve accelerates all the time
+// (v²/r = 2.2 m/s² at 1.5 m/s on a 1 m radius): a constant-velocity model
+// either lags or predicts 66 ms ahead 5 mm off (docs/latency.md has the
+// figures). Allocation-free, header-only: the C client links no pipeline.
+#include <array>
+#include <cmath>
+#include <cstdint>
+
+#include "core/pose.h"
+
+namespace ceilpose {
+
+inline constexpr int kMotionAxes = 3;    // x, y, yaw
+inline constexpr int kMotionOrders = 3;  // value, rate, acceleration
+inline constexpr int kMotionStates = kMotionAxes * kMotionOrders;
+
+struct MotionState {
+  std::array<double, kMotionStates> x{};
+  std::array<double, kMotionStates * kMotionStates> p{};  // covariance, row-major
+};
+
+// Process noise: the jerk's power spectral density per axis, (m/s³)²·s for
+// x and y, (rad/s³)²·s for yaw. `filter.jerk_sigma_mps3` is its square root.
+using JerkDensity = std::array<double, kMotionAxes>;
+
+// Propagates `in` by dt_s seconds (either sign; the added noise grows with
+// |dt|) into `out` (may alias `in` only if they are distinct objects: pass a
+// copy). Only the first `orders` derivative orders of `out` are computed
+// (1: pose, 2: pose and rates, 3: all); the rest of `out` is left unchanged.
+// The yaw is not wrapped.
+inline void propagate_motion(const MotionState& in, double dt_s, const JerkDensity& jerk,
+                             MotionState* out, int orders = kMotionOrders) {
+  constexpr int A = kMotionAxes;
+  constexpr int N = kMotionStates;
+  // Row k of F maps order k from orders k..2 with c = [1, dt, dt²/2].
+  const double c[kMotionOrders] = {1.0, dt_s, 0.5 * dt_s * dt_s};
+  for (int i = 0; i < orders; ++i)
+    for (int a = 0; a < A; ++a) {
+      double sum = 0.0;
+      for (int k = i; k < kMotionOrders; ++k) sum += c[k - i] * in.x[k * A + a];
+      out->x[i * A + a] = sum;
+    }
+  // P' block (i, j) = Σ_{k≥i, l≥j} c[k-i] c[l-j] P block (k, l).
+  for (int i = 0; i < orders; ++i)
+    for (int j = 0; j < orders; ++j)
+      for (int a = 0; a < A; ++a)
+        for (int b = 0; b < A; ++b) {
+          double sum = 0.0;
+          for (int k = i; k < kMotionOrders; ++k) {
+            double row = 0.0;
+            for (int l = j; l < kMotionOrders; ++l)
+              row += c[l - j] * in.p[(k * A + a) * N + l * A + b];
+            sum += c[k - i] * row;
+          }
+          out->p[(i * A + a) * N + j * A + b] = sum;
+        }
+  // White jerk, integrated over |dt|: q·[t⁵/20 t⁴/8 t³/6; t⁴/8 t³/3 t²/2; t³/6 t²/2 t].
+  const double t = std::abs(dt_s);
+  const double t2 = t * t, t3 = t2 * t;
+  const double q[kMotionOrders][kMotionOrders] = {{t3 * t2 / 20.0, t2 * t2 / 8.0, t3 / 6.0},
+                                                  {t2 * t2 / 8.0, t3 / 3.0, t2 / 2.0},
+                                                  {t3 / 6.0, t2 / 2.0, t}};
+  for (int i = 0; i < orders; ++i)
+    for (int j = 0; j < orders; ++j)
+      for (int a = 0; a < A; ++a) out->p[(i * A + a) * N + j * A + a] += jerk[a] * q[i][j];
+}
+
+// The filter's belief at one instant, with the noise needed to carry it to
+// another: what the daemon publishes with every filtered pose.
+struct MotionEstimate {
+  bool valid = false;
+  int64_t time_ns = 0;  // CLOCK_MONOTONIC instant `state` refers to (the frame's)
+  MotionState state;
+  JerkDensity jerk{};
+};
+
+// The estimate carried to t_ns: pose (yaw wrapped) and rates with their
+// covariance (orders 0 and 1 only; the accelerations stay as they were).
+inline MotionState motion_at(const MotionEstimate& m, int64_t t_ns) {
+  MotionState out = m.state;
+  propagate_motion(m.state, static_cast<double>(t_ns - m.time_ns) * 1e-9, m.jerk, &out, 2);
+  out.x[2] = wrap_angle_rad(out.x[2]);
+  return out;
+}
+
+}  // namespace ceilpose
