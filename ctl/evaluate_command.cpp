@@ -48,15 +48,17 @@ void print_motion(const MotionReport& m, bool json) {
   if (json) {
     std::printf(
         ",\"motion\":{\"frames\":%d,\"median_error_mm\":%.4f,\"p99_error_mm\":%.4f,"
-        "\"max_error_mm\":%.4f,\"yaw_p99_deg\":%.4f,\"velocity_median_error_mps\":%.5f,"
+        "\"max_error_mm\":%.4f,\"yaw_p99_deg\":%.4f,\"velocity_frames\":%d,"
+        "\"velocity_median_error_mps\":%.5f,"
         "\"velocity_p99_error_mps\":%.5f,\"yaw_rate_median_error_radps\":%.5f,"
         "\"predict_ms\":%.3f,\"predicted_frames\":%d,\"predicted_median_error_mm\":%.4f,"
         "\"predicted_p99_error_mm\":%.4f,\"predicted_max_error_mm\":%.4f,"
         "\"predicted_yaw_p99_deg\":%.4f,\"unpredicted_p99_error_mm\":%.4f}",
         m.frames, m.median_error_mm, m.p99_error_mm, m.max_error_mm, m.yaw_p99_deg,
-        m.velocity_median_error_mps, m.velocity_p99_error_mps, m.yaw_rate_median_error_radps,
-        m.predict_ms, m.predicted_frames, m.predicted_median_error_mm, m.predicted_p99_error_mm,
-        m.predicted_max_error_mm, m.predicted_yaw_p99_deg, m.unpredicted_p99_error_mm);
+        m.velocity_frames, m.velocity_median_error_mps, m.velocity_p99_error_mps,
+        m.yaw_rate_median_error_radps, m.predict_ms, m.predicted_frames,
+        m.predicted_median_error_mm, m.predicted_p99_error_mm, m.predicted_max_error_mm,
+        m.predicted_yaw_p99_deg, m.unpredicted_p99_error_mm);
     return;
   }
   std::printf(

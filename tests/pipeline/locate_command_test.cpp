@@ -90,6 +90,8 @@ class LocateCommand : public ::testing::Test {
     return rec;
   }
 
+  std::string rec_of(const std::vector<Pose2D>& poses) { return record(poses).string(); }
+
   fs::path dir_;
 };
 
@@ -149,6 +151,34 @@ TEST_F(LocateCommand, ForcedModeIsReportedAndFilterKeepsEveryFrame) {
   const auto out = lines(r.out);
   ASSERT_EQ(out.size(), 3u);
   EXPECT_NEAR(field(out[2], "x_m"), 1.22, 0.01);
+}
+
+// SPEC §5: --filter adds the velocity; --predict-ms MS gives the pose MS past
+// each frame and echoes MS. A robot driving East at 0.6 m/s.
+TEST_F(LocateCommand, FilterGivesVelocityAndPredictMsThePoseAhead) {
+  std::vector<Pose2D> poses;
+  for (int k = 0; k < 30; ++k) poses.push_back({1.0 + 0.02 * k, 1.5, 0.0});
+  const fs::path rec = record(poses);
+  CommandRun r = run("locate --replay " + rec.string());
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_EQ(r.out.find("vx_mps"), std::string::npos) << "per frame: no velocity";
+  r = run("locate --filter --replay " + rec.string());
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  auto out = lines(r.out);
+  ASSERT_EQ(out.size(), poses.size());
+  EXPECT_NEAR(field(out.back(), "vx_mps"), 0.6, 0.01) << out.back();
+  EXPECT_NEAR(field(out.back(), "vy_mps"), 0.0, 0.01) << out.back();
+  EXPECT_NEAR(field(out.back(), "yaw_rate_radps"), 0.0, 0.01) << out.back();
+  EXPECT_TRUE(std::isnan(field(out.back(), "predict_ms"))) << out.back();
+  const double x_now = field(out.back(), "x_m");
+  r = run("locate --predict-ms 100 --replay " + rec.string());  // implies --filter
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  out = lines(r.out);
+  ASSERT_EQ(out.size(), poses.size());
+  EXPECT_EQ(field(out.back(), "predict_ms"), 100.0) << out.back();
+  EXPECT_NEAR(field(out.back(), "x_m") - x_now, 0.06, 0.002) << out.back();
+  EXPECT_NEAR(field(out.back(), "vx_mps"), 0.6, 0.01) << out.back();
+  EXPECT_EQ(run("locate --predict-ms nope --replay " + rec.string()).exit_code, 2);
 }
 
 TEST_F(LocateCommand, MalformedRecordingExitsFourNamingFileAndLine) {
@@ -331,6 +361,21 @@ TEST_F(LocateCommand, EvaluateScoresAgainstGroundTruth) {
   EXPECT_EQ(field(r.out, "within_both"), 1.0) << r.out;
   EXPECT_EQ(field(r.out, "gross"), 0.0) << r.out;
   EXPECT_LT(field(r.out, "max_error_mm"), 5.0) << r.out;
+  EXPECT_EQ(r.out.find("\"motion\""), std::string::npos) << "motion only with the filter";
+}
+
+TEST_F(LocateCommand, EvaluateWithTheFilterScoresVelocityAndPrediction) {
+  std::vector<Pose2D> poses;
+  for (int k = 0; k < 30; ++k) poses.push_back({1.0 + 0.02 * k, 1.5, 0.0});  // 0.6 m/s East
+  const CommandRun r = run("evaluate --json --predict-ms 66.666 --replay " + rec_of(poses));
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const std::string motion = r.out.substr(r.out.find("\"motion\""));
+  EXPECT_EQ(field(motion, "frames"), 30.0) << r.out;
+  EXPECT_EQ(field(motion, "velocity_frames"), 28.0) << r.out;
+  EXPECT_LT(field(motion, "velocity_median_error_mps"), 0.01) << r.out;
+  EXPECT_EQ(field(motion, "predicted_frames"), 28.0) << r.out;  // the last two have no truth ahead
+  EXPECT_LT(field(motion, "predicted_median_error_mm"), 1.0) << r.out;
+  EXPECT_NEAR(field(motion, "unpredicted_p99_error_mm"), 40.0, 2.0) << r.out;
 }
 
 }  // namespace
