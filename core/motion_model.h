@@ -79,6 +79,7 @@ struct MotionEstimate {
   int64_t time_ns = 0;  // CLOCK_MONOTONIC instant `state` refers to (the frame's)
   MotionState state;
   JerkDensity jerk{};
+  double horizon_ms = 0.0;  // how far from time_ns a consumer may carry it
 };
 
 // The estimate carried to t_ns: pose (yaw wrapped) and rates with their

@@ -21,6 +21,7 @@ void ShmPoseSink::consume(const Localization& loc) {
   rec.mode = static_cast<uint8_t>(out.mode);
   rec.markers = static_cast<uint16_t>(out.markers);
   rec.refusal = static_cast<uint8_t>(out.refusal);
+  set_pose_motion(&rec, loc.motion);
   writer_->publish(rec);
 }
 

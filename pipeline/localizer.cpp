@@ -46,6 +46,7 @@ const Localization& Localizer::localize(const ImageView& image, const FrameInfo&
     out_.motion.time_ns = filter_.state_time_ns();
     out_.motion.state = filter_.state();
     out_.motion.jerk = filter_.jerk_density();
+    out_.motion.horizon_ms = pipeline_.config().filter.predict_horizon_ms;
   }
 
   // 3. Fix state.

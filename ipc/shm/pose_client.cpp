@@ -89,6 +89,22 @@ int ceilpose_client_wait_next(ceilpose_client* client, uint64_t after_seq, int32
   return wait_code(client->reader.wait_next(after_seq, timeout_ms, out));
 }
 
+int ceilpose_client_predict(ceilpose_client* client, int64_t t_mono_ns, ceilpose_pose* out) {
+  if (client == nullptr || out == nullptr) return CEILPOSE_ERR_INVALID_ARGUMENT;
+  ceilpose_pose latest;
+  const int rc = read_code(client->reader.read_latest(&latest));
+  if (rc != CEILPOSE_OK) return rc;
+  switch (ceilpose::predict_pose(latest, t_mono_ns, out)) {
+    case ceilpose::PredictResult::kOk:
+      return CEILPOSE_OK;
+    case ceilpose::PredictResult::kNoMotion:
+      return CEILPOSE_ERR_NO_MOTION;
+    case ceilpose::PredictResult::kBeyondHorizon:
+      return CEILPOSE_ERR_HORIZON;
+  }
+  return CEILPOSE_ERR_SYSTEM;
+}
+
 int ceilpose_client_liveness(ceilpose_client* client, int64_t stale_after_ms,
                              enum ceilpose_liveness* out) {
   if (client == nullptr || out == nullptr || stale_after_ms < 0) {
@@ -203,6 +219,10 @@ const char* ceilpose_strerror(int code) {
       return "another daemon is publishing on that name";
     case CEILPOSE_ERR_NO_GROUP:
       return "the configured group does not exist";
+    case CEILPOSE_ERR_NO_MOTION:
+      return "the latest pose is invalid or has no filter motion to predict from";
+    case CEILPOSE_ERR_HORIZON:
+      return "the instant is beyond the prediction horizon of the latest pose";
     default:
       return "unknown error code";
   }

@@ -7,6 +7,7 @@
 
 #include "ceilpose/pose_client.h"
 #include "core/fix_state.h"
+#include "core/motion_model.h"
 #include "core/positioning_mode.h"
 #include "core/refusal.h"
 
@@ -25,6 +26,8 @@ static_assert(kRefusalCount <= CEILPOSE_REFUSAL_SLOTS, "a status slot for every 
 inline constexpr uint32_t kPoseValid = CEILPOSE_POSE_VALID;
 inline constexpr uint32_t kPoseFiltered = CEILPOSE_POSE_FILTERED;
 inline constexpr uint32_t kPoseCoasting = CEILPOSE_POSE_COASTING;
+inline constexpr uint32_t kPoseMotion = CEILPOSE_POSE_MOTION;
+static_assert(kMotionStates == CEILPOSE_STATE_SIZE, "core/motion_model.h and the C client agree");
 
 static_assert(static_cast<uint32_t>(FixState::kNone) == CEILPOSE_FIX_NONE &&
                   static_cast<uint32_t>(FixState::kOk) == CEILPOSE_FIX_OK &&
@@ -44,6 +47,17 @@ const char* to_string(WriterState state);
 const char* pose_mode_name(uint8_t mode);
 
 inline bool pose_is_valid(const PoseRecord& p) { return (p.flags & kPoseValid) != 0; }
+
+// The filter's motion into the record's motion fields and CEILPOSE_POSE_MOTION
+// (cleared, and the fields zeroed, when `motion` is not valid).
+void set_pose_motion(PoseRecord* pose, const MotionEstimate& motion);
+// The record's motion, at its capture time; not valid without the flag.
+MotionEstimate pose_motion(const PoseRecord& pose);
+
+enum class PredictResult { kOk, kNoMotion, kBeyondHorizon };
+// `pose` carried to t_mono_ns (ceilpose_client_predict): pose, yaw, rates and
+// their covariance at that instant; *out is `pose` unchanged unless kOk.
+PredictResult predict_pose(const PoseRecord& pose, int64_t t_mono_ns, PoseRecord* out);
 
 // Copies `text` into the status record's fixed source field, truncating and
 // always NUL-terminating.

@@ -47,6 +47,15 @@ std::string pose_json(const PoseRecord& p, int64_t now_mono_ns, const std::strin
   } else {
     out += ",\"cov\":null";
   }
+  if (valid && (p.flags & kPoseMotion) != 0) {
+    const double* v = p.state_covariance;
+    constexpr int n = CEILPOSE_STATE_SIZE;
+    out += format(
+        ",\"vx_mps\":%.6f,\"vy_mps\":%.6f,\"yaw_rate_radps\":%.6f,\"velocity_cov\":[%.3e,%.3e,%.3e,"
+        "%.3e,%.3e,%.3e]",
+        p.vx_mps, p.vy_mps, p.yaw_rate_radps, v[3 * n + 3], v[3 * n + 4], v[3 * n + 5],
+        v[4 * n + 4], v[4 * n + 5], v[5 * n + 5]);
+  }
   return out + extra + "}";
 }
 

@@ -12,7 +12,9 @@ namespace ceilpose {
 // One JSON object, no newline: seq, valid, x_m, y_m, yaw_rad (null when
 // invalid), mode, markers, timestamp_ns (capture, CLOCK_MONOTONIC, as SPEC §4),
 // then capture_real_ns, publish_real_ns, age_ms, filtered, coasting and cov
-// (upper triangle xx, xy, xyaw, yy, yyaw, yawyaw; null when invalid).
+// (upper triangle xx, xy, xyaw, yy, yyaw, yawyaw; null when invalid), and
+// with the filter's motion vx_mps, vy_mps, yaw_rate_radps and velocity_cov
+// (the same upper triangle of the rates).
 // `extra` (e.g. ",\"daemon\":\"stale\"") is appended inside the braces.
 std::string pose_json(const PoseRecord& pose, int64_t now_mono_ns, const std::string& extra = "");
 // The same fields, all null, for "no pose" answers.

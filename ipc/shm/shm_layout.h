@@ -139,9 +139,9 @@ static_assert(offsetof(SegmentHeader, wake_seq) == 68, "layout of docs/ipc.md");
 static_assert(offsetof(SegmentHeader, heartbeat_mono_ns) == 72, "layout of docs/ipc.md");
 static_assert(offsetof(SegmentHeader, latest_seq) == 80, "layout of docs/ipc.md");
 static_assert(offsetof(SegmentHeader, stale_after_ms) == 88, "layout of docs/ipc.md");
-static_assert(offsetof(Segment, ring) == 640, "layout of docs/ipc.md");
-static_assert(sizeof(SeqlockSlot<PoseRecord>) == 192, "layout of docs/ipc.md");
+static_assert(offsetof(Segment, ring) == 1344, "layout of docs/ipc.md");
+static_assert(sizeof(SeqlockSlot<PoseRecord>) == 896, "layout of docs/ipc.md");
 static_assert(sizeof(SeqlockSlot<StatusRecord>) == 320, "layout of docs/ipc.md");
-static_assert(sizeof(Segment) == 128 + 192 + 320 + 192 * kRingLength, "layout of docs/ipc.md");
+static_assert(sizeof(Segment) == 128 + 896 + 320 + 896 * kRingLength, "layout of docs/ipc.md");
 
 }  // namespace ceilpose::shm

@@ -7,6 +7,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <fstream>
 #include <map>
 #include <sstream>
@@ -124,6 +125,32 @@ TEST_F(DaemonLifecycle, SigtermStopsWithinASecondWithExitZeroAndSegmentMarkedSto
   EXPECT_EQ(reader->writer_info().state, WriterState::kStopped);
   EXPECT_EQ(reader->liveness(1000), Liveness::kStopped);
   EXPECT_TRUE(notify_.wait_for("STOPPING=1", 1000));
+}
+
+// Issue 13: with the filter on, every pose carries the filter's motion, and
+// the synthetic patrol's 1.2 m/s shows in it.
+TEST_F(DaemonLifecycle, FilteredPosesCarryVelocityForPrediction) {
+  config_ = write_temp_file("ceilpose.yaml",
+                            "filter:\n  enabled: true\nwatchdog:\n  status_interval_ms: 200\n"
+                            "dds:\n  enabled: false\n");
+  auto daemon = start();
+  ASSERT_TRUE(notify_.wait_for("READY=1", kStartTimeoutMs)) << daemon->err();
+  auto reader = ShmPoseReader::open_waiting(shm_, 5000);
+  ASSERT_TRUE(reader) << reader.error().message;
+  PoseRecord pose{};
+  for (int k = 0; k < 30; ++k) {  // let the velocity settle
+    pose = next_pose(*reader, pose.seq);
+    ASSERT_NE(pose.seq, 0u) << daemon->err();
+  }
+  ASSERT_TRUE(pose_is_valid(pose));
+  ASSERT_NE(pose.flags & kPoseMotion, 0u);
+  EXPECT_NEAR(std::hypot(pose.vx_mps, pose.vy_mps), 1.2, 0.05);
+  EXPECT_EQ(pose.predict_horizon_ms, 200u);
+  PoseRecord ahead{};
+  ASSERT_EQ(predict_pose(pose, pose.capture_mono_ns + 50'000'000, &ahead), PredictResult::kOk);
+  EXPECT_NEAR(std::hypot(ahead.x_m - pose.x_m, ahead.y_m - pose.y_m), 0.06, 0.005);
+  daemon->signal(SIGTERM);
+  ASSERT_TRUE(daemon->wait(5000).has_value());
 }
 
 TEST_F(DaemonLifecycle, SigintStopsCleanlyToo) {

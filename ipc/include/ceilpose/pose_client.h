@@ -30,7 +30,7 @@ extern "C" {
 
 /* Version of the shared-segment layout and of these records. A reader refuses
  * a segment of another version (CEILPOSE_ERR_ABI_MISMATCH). */
-#define CEILPOSE_CLIENT_ABI_VERSION 2
+#define CEILPOSE_CLIENT_ABI_VERSION 3
 /* Default segment name (SPEC §7: --shm defaults to /ceilpose). */
 #define CEILPOSE_DEFAULT_SHM_NAME "/ceilpose"
 /* Poses kept in the segment's ring of recent poses. */
@@ -43,6 +43,9 @@ extern "C" {
 #define CEILPOSE_POSE_VALID 0x1u    /* x_m, y_m, yaw_rad and covariance hold a pose */
 #define CEILPOSE_POSE_FILTERED 0x2u /* the temporal filter produced this pose */
 #define CEILPOSE_POSE_COASTING 0x4u /* predicted: no marker fix in this frame */
+#define CEILPOSE_POSE_MOTION 0x8u   /* velocity, acceleration and state_covariance are set */
+/* Entries of ceilpose_pose.state_covariance (9 x 9, row-major). */
+#define CEILPOSE_STATE_SIZE 9
 
 /* ceilpose_pose.mode: the positioning method used (SPEC §5 "mode" names). */
 enum ceilpose_mode {
@@ -61,7 +64,8 @@ enum ceilpose_fix_state {
 };
 
 /* One published pose. Times: *_mono_ns on CLOCK_MONOTONIC, *_real_ns on
- * CLOCK_REALTIME, both in nanoseconds. */
+ * CLOCK_REALTIME, both in nanoseconds. capture_mono_ns is the middle of the
+ * frame's exposure (docs/latency.md): the instant the pose and motion are of. */
 typedef struct ceilpose_pose {
   uint64_t seq;            /* 1, 2, 3, ... per writer generation; 0 = none */
   int64_t capture_mono_ns; /* when the camera captured the frame */
@@ -76,6 +80,26 @@ typedef struct ceilpose_pose {
   uint8_t mode;         /* enum ceilpose_mode */
   uint8_t refusal;      /* why the frame gave no measurement: ceilpose_refusal_name(); 0 "none" */
   uint16_t markers;     /* decoded markers used */
+  /* ABI 3: the temporal filter's motion at capture_mono_ns, world frame
+   * (CEILPOSE_POSE_MOTION; zero without it). ceilpose_client_predict carries
+   * the pose to another instant with them. */
+  double vx_mps;
+  double vy_mps;
+  double yaw_rate_radps; /* CCW positive */
+  double ax_mps2;
+  double ay_mps2;
+  double yaw_accel_radps2;
+  /* Covariance of the filter's state (x_m, y_m, yaw_rad, vx_mps, vy_mps,
+   * yaw_rate_radps, ax_mps2, ay_mps2, yaw_accel_radps2), row-major, SI units
+   * squared: the velocity's is rows and columns 3-5; rows 0-2 = covariance. */
+  double state_covariance[CEILPOSE_STATE_SIZE * CEILPOSE_STATE_SIZE];
+  /* The process noise prediction adds: the jerk's power spectral density of
+   * x, y ((m/s^3)^2 s) and yaw ((rad/s^3)^2 s). */
+  double jerk_density[3];
+  /* ceilpose_client_predict refuses instants further than this from
+   * capture_mono_ns (the daemon's filter.predict_horizon_ms). */
+  uint32_t predict_horizon_ms;
+  uint32_t reserved0;
 } ceilpose_pose;
 
 /* Daemon health, what `ceilposectl status` shows. Filled by the daemon about
@@ -148,7 +172,9 @@ enum ceilpose_error {
   CEILPOSE_ERR_STOPPED = -13,     /* the daemon stopped cleanly */
   CEILPOSE_ERR_WRITER_DEAD = -14, /* the writer process is gone */
   CEILPOSE_ERR_LIVE_WRITER = -15, /* (writer side) another daemon owns the name */
-  CEILPOSE_ERR_NO_GROUP = -16     /* (writer side) configured group does not exist */
+  CEILPOSE_ERR_NO_GROUP = -16,    /* (writer side) configured group does not exist */
+  CEILPOSE_ERR_NO_MOTION = -17,   /* the latest pose is invalid or carries no motion */
+  CEILPOSE_ERR_HORIZON = -18      /* the instant is beyond predict_horizon_ms of the frame */
 };
 
 typedef struct ceilpose_client ceilpose_client;
@@ -171,6 +197,16 @@ int ceilpose_client_read_latest(ceilpose_client* client, ceilpose_pose* out);
  * when no pose can come from this writer any more. */
 int ceilpose_client_wait_next(ceilpose_client* client, uint64_t after_seq, int32_t timeout_ms,
                               ceilpose_pose* out);
+
+/* The latest pose carried to t_mono_ns (CLOCK_MONOTONIC), "where am I now":
+ * position, yaw, velocity and their covariance (grown by the process noise)
+ * at that instant, by the filter's own constant-acceleration model; the
+ * capture_* and publish_* times still name the frame it came from. Lock-free
+ * and allocation-free, like read_latest. Returns CEILPOSE_ERR_NO_MOTION when
+ * the latest pose is invalid or unfiltered, CEILPOSE_ERR_HORIZON when
+ * |t_mono_ns - capture_mono_ns| exceeds its predict_horizon_ms (*out then
+ * still holds the latest pose, unpredicted). */
+int ceilpose_client_predict(ceilpose_client* client, int64_t t_mono_ns, ceilpose_pose* out);
 
 /* Judges the writer: stopped, dead (pid gone), stale (heartbeat older than
  * stale_after_ms; 0 = the daemon's own ipc.stale_after_ms, published in the
@@ -214,11 +250,15 @@ const char* ceilpose_last_error_message(void);
 #else
 #define CEILPOSE_STATIC_ASSERT(c, m) _Static_assert(c, m)
 #endif
-CEILPOSE_STATIC_ASSERT(sizeof(ceilpose_pose) == 144, "ceilpose_pose layout");
+CEILPOSE_STATIC_ASSERT(sizeof(ceilpose_pose) == 872, "ceilpose_pose layout");
 CEILPOSE_STATIC_ASSERT(offsetof(ceilpose_pose, x_m) == 40, "ceilpose_pose.x_m offset");
 CEILPOSE_STATIC_ASSERT(offsetof(ceilpose_pose, covariance) == 64, "ceilpose_pose.covariance");
 CEILPOSE_STATIC_ASSERT(offsetof(ceilpose_pose, flags) == 136, "ceilpose_pose.flags offset");
 CEILPOSE_STATIC_ASSERT(offsetof(ceilpose_pose, markers) == 142, "ceilpose_pose.markers offset");
+CEILPOSE_STATIC_ASSERT(offsetof(ceilpose_pose, vx_mps) == 144, "ceilpose_pose.vx_mps offset");
+CEILPOSE_STATIC_ASSERT(offsetof(ceilpose_pose, state_covariance) == 192, "state_covariance");
+CEILPOSE_STATIC_ASSERT(offsetof(ceilpose_pose, jerk_density) == 840, "jerk_density offset");
+CEILPOSE_STATIC_ASSERT(offsetof(ceilpose_pose, predict_horizon_ms) == 864, "horizon offset");
 CEILPOSE_STATIC_ASSERT(sizeof(ceilpose_status) == 304, "ceilpose_status layout");
 CEILPOSE_STATIC_ASSERT(offsetof(ceilpose_status, refusals) == 176, "ceilpose_status.refusals");
 CEILPOSE_STATIC_ASSERT(offsetof(ceilpose_status, latency_p50_us) == 40, "status latency offset");

@@ -116,12 +116,66 @@ TEST_F(CClient, ReadRecentReturnsNewestFirst) {
   EXPECT_EQ(recent[3].seq, 7u);
 }
 
+// A pose from the filter: at x = 1 m, driving East at 0.5 m/s, accelerating
+// North at 2 m/s², turning at 1 rad/s; 1 mm / 0.1 m/s / 1 m/s² sigmas.
+PoseRecord moving_pose(int64_t capture_ns) {
+  PoseRecord p{};
+  p.capture_mono_ns = capture_ns;
+  p.x_m = 1.0;
+  p.y_m = 2.0;
+  p.yaw_rad = 0.5;
+  p.flags = kPoseValid | kPoseFiltered;
+  MotionEstimate m;
+  m.valid = true;
+  m.time_ns = capture_ns;
+  m.state.x = {1.0, 2.0, 0.5, 0.5, 0.0, 1.0, 0.0, 2.0, 0.0};
+  const double sigma[kMotionStates] = {1e-3, 1e-3, 1e-3, 0.1, 0.1, 0.1, 1.0, 1.0, 1.0};
+  for (int i = 0; i < kMotionStates; ++i) m.state.p[i * kMotionStates + i] = sigma[i] * sigma[i];
+  m.jerk = {100.0, 100.0, 100.0};
+  m.horizon_ms = 200.0;
+  set_pose_motion(&p, m);
+  return p;
+}
+
+TEST_F(CClient, PredictCarriesTheLatestPoseToTheAskedInstant) {
+  ASSERT_NO_FATAL_FAILURE(start());
+  ClientPtr client = open_client(name());
+  ceilpose_pose p;
+  EXPECT_EQ(ceilpose_client_predict(client.get(), 0, &p), CEILPOSE_ERR_NO_POSE);
+  const int64_t t0 = 5'000'000'000;
+  writer().publish(moving_pose(t0));
+  ASSERT_EQ(ceilpose_client_predict(client.get(), t0 + 100'000'000, &p), CEILPOSE_OK);
+  // x + v t, y + a t²/2, yaw + w t at t = 0.1 s.
+  EXPECT_NEAR(p.x_m, 1.05, 1e-12);
+  EXPECT_NEAR(p.y_m, 2.01, 1e-12);
+  EXPECT_NEAR(p.yaw_rad, 0.6, 1e-12);
+  EXPECT_NEAR(p.vy_mps, 0.2, 1e-12);
+  EXPECT_EQ(p.capture_mono_ns, t0) << "the frame it came from";
+  // Var x = σx² + t²σv² + t⁴/4 σa² + q t⁵/20.
+  const double var_x = 1e-6 + 0.01 * 0.01 + 1e-4 / 4 + 100.0 * 1e-5 / 20;
+  EXPECT_NEAR(p.covariance[0], var_x, 1e-12);
+  EXPECT_NEAR(p.state_covariance[0], var_x, 1e-12);
+  EXPECT_GT(p.state_covariance[3 * 9 + 3], 0.01) << "velocity variance grows too";
+  // Backwards within the horizon works; beyond it is refused, pose untouched.
+  ASSERT_EQ(ceilpose_client_predict(client.get(), t0 - 50'000'000, &p), CEILPOSE_OK);
+  EXPECT_NEAR(p.x_m, 0.975, 1e-12);
+  EXPECT_EQ(ceilpose_client_predict(client.get(), t0 + 200'000'001, &p), CEILPOSE_ERR_HORIZON);
+  EXPECT_EQ(p.x_m, 1.0);
+  EXPECT_EQ(ceilpose_client_predict(client.get(), INT64_MIN, &p), CEILPOSE_ERR_HORIZON);
+  // An unfiltered or invalid latest pose has nothing to carry.
+  PoseRecord still = moving_pose(t0 + 1);
+  set_pose_motion(&still, MotionEstimate{});
+  writer().publish(still);
+  EXPECT_EQ(ceilpose_client_predict(client.get(), t0 + 1, &p), CEILPOSE_ERR_NO_MOTION);
+  EXPECT_EQ(ceilpose_client_predict(nullptr, t0, &p), CEILPOSE_ERR_INVALID_ARGUMENT);
+}
+
 TEST_F(CClient, EveryErrorCodeHasItsOwnText) {
   std::set<std::string> texts;
-  for (int code = CEILPOSE_OK; code >= CEILPOSE_ERR_NO_GROUP; --code) {
+  for (int code = CEILPOSE_OK; code >= CEILPOSE_ERR_HORIZON; --code) {
     texts.insert(ceilpose_strerror(code));
   }
-  EXPECT_EQ(texts.size(), static_cast<size_t>(1 - CEILPOSE_ERR_NO_GROUP));
+  EXPECT_EQ(texts.size(), static_cast<size_t>(1 - CEILPOSE_ERR_HORIZON));
   EXPECT_EQ(texts.count(ceilpose_strerror(-1000)), 0u);
 }
 

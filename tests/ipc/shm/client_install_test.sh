@@ -12,8 +12,8 @@ pc_dir=$(dirname "$(find "$prefix" -name ceilpose-client.pc)")
 for f in include/ceilpose/pose_client.h; do
   test -f "$prefix/$f" || { echo "missing $f in the install"; exit 1; }
 done
-test -n "$(find "$prefix" -name libceilpose_client.so.2)" ||
-  { echo "libceilpose_client.so.2 not installed"; exit 1; }
+test -n "$(find "$prefix" -name libceilpose_client.so.3)" ||
+  { echo "libceilpose_client.so.3 not installed"; exit 1; }
 flags=$(PKG_CONFIG_PATH=$pc_dir pkg-config --cflags --libs ceilpose-client)
 cc -std=c11 -Wall -Wextra -Wpedantic -Werror "$source_file" $flags -o "$prefix/printer"
 libdir=$(PKG_CONFIG_PATH=$pc_dir pkg-config --variable=libdir ceilpose-client)

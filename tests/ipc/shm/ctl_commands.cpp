@@ -4,6 +4,8 @@
 
 #include <atomic>
 #include <chrono>
+#include <cmath>
+#include <cstdlib>
 #include <thread>
 #include <vector>
 
@@ -82,6 +84,67 @@ TEST_F(CtlCommands, PoseJsonPrintsLivePoseWithSpecFieldsAndExitsZero) {
   EXPECT_TRUE(contains(out_, "\"markers\":9")) << out_;
   EXPECT_TRUE(contains(out_, "\"timestamp_ns\":123456789")) << out_;
   EXPECT_EQ(count_lines(out_), 1u);
+}
+
+// The number after "key": in `text` (NaN when absent).
+double number_after(const std::string& text, const std::string& key) {
+  const size_t at = text.find("\"" + key + "\":");
+  return at == std::string::npos ? NAN : std::strtod(text.c_str() + at + key.size() + 3, nullptr);
+}
+
+// Driving East at 1 m/s; the horizon (in ms) the daemon would publish.
+PoseRecord moving_pose(int64_t capture_mono_ns, double horizon_ms) {
+  PoseRecord p = sample_pose(capture_mono_ns);
+  MotionEstimate m;
+  m.valid = true;
+  m.time_ns = capture_mono_ns;
+  m.state.x = {p.x_m, p.y_m, p.yaw_rad, 1.0, 0.0, 0.0, 0.0, 0.0, 0.0};
+  for (int i = 0; i < kMotionStates; ++i) m.state.p[i * kMotionStates + i] = 1e-6;
+  m.jerk = {1.0, 1.0, 1.0};
+  m.horizon_ms = horizon_ms;
+  set_pose_motion(&p, m);
+  return p;
+}
+
+TEST_F(CtlCommands, PoseJsonCarriesTheFiltersVelocity) {
+  ASSERT_NO_FATAL_FAILURE(start());
+  writer().publish(moving_pose(123456789, 200.0));
+  EXPECT_EQ(run({"pose", "--shm", name(), "--json", "--stale-ms", kLenientStaleMs}), 0) << err_;
+  EXPECT_EQ(number_after(out_, "vx_mps"), 1.0) << out_;
+  EXPECT_EQ(number_after(out_, "vy_mps"), 0.0) << out_;
+  EXPECT_EQ(number_after(out_, "yaw_rate_radps"), 0.0) << out_;
+  EXPECT_TRUE(contains(out_, "\"velocity_cov\":[1.000e-06,")) << out_;
+  EXPECT_FALSE(contains(out_, "predict_ms")) << out_;
+}
+
+TEST_F(CtlCommands, PoseAtPredictsWhereTheRobotIsNowOrSoon) {
+  ASSERT_NO_FATAL_FAILURE(start());
+  // A horizon lenient enough for ceilposectl's start-up on a loaded machine.
+  writer().publish(moving_pose(monotonic_ns(), 60000.0));
+  EXPECT_EQ(run({"pose", "--shm", name(), "--json", "--at", "now", "--stale-ms", kLenientStaleMs}),
+            0)
+      << err_;
+  double ahead_ms = number_after(out_, "predict_ms");
+  EXPECT_GT(ahead_ms, 0.0) << out_;
+  EXPECT_NEAR(number_after(out_, "x_m"), 1.25 + ahead_ms * 1e-3, 1e-6) << out_;
+  EXPECT_EQ(run({"pose", "--shm", name(), "--json", "--at", "+250", "--stale-ms", kLenientStaleMs}),
+            0)
+      << err_;
+  ahead_ms = number_after(out_, "predict_ms");
+  EXPECT_GT(ahead_ms, 250.0) << out_;
+  EXPECT_NEAR(number_after(out_, "x_m"), 1.25 + ahead_ms * 1e-3, 1e-6) << out_;
+  EXPECT_EQ(run({"pose", "--shm", name(), "--at", "soon"}), 2);
+  EXPECT_EQ(run({"pose", "--shm", name(), "--at", "+-5"}), 2);
+}
+
+TEST_F(CtlCommands, PoseAtRefusesBeyondTheHorizonOrWithoutMotion) {
+  ASSERT_NO_FATAL_FAILURE(start());
+  writer().publish(moving_pose(monotonic_ns(), 200.0));
+  EXPECT_EQ(run({"pose", "--shm", name(), "--at", "+5000", "--stale-ms", kLenientStaleMs}), 1);
+  EXPECT_TRUE(contains(err_, "beyond the daemon's predict horizon of 200 ms")) << err_;
+  writer().publish(sample_pose(monotonic_ns()));  // no motion
+  EXPECT_EQ(run({"pose", "--shm", name(), "--at", "now", "--stale-ms", kLenientStaleMs}), 1);
+  EXPECT_TRUE(contains(err_, "nothing to predict from")) << err_;
 }
 
 TEST_F(CtlCommands, PoseJsonHasNullPoseFieldsWhenInvalid) {

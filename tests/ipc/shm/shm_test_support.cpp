@@ -39,6 +39,11 @@ PoseRecord check_pose(uint64_t k) {
   p.flags = kPoseValid | static_cast<uint32_t>((k & 1) != 0 ? kPoseFiltered : 0);
   p.mode = static_cast<uint8_t>(k % 4);
   p.markers = static_cast<uint16_t>(k & 0xffff);
+  // The motion words too: a torn copy of the record's tail must show.
+  p.vx_mps = static_cast<double>(k) * 0.25;
+  for (int i = 0; i < CEILPOSE_STATE_SIZE * CEILPOSE_STATE_SIZE; ++i)
+    p.state_covariance[i] = static_cast<double>(k * 3 + static_cast<uint64_t>(i));
+  p.predict_horizon_ms = static_cast<uint32_t>(k);
   return p;
 }
 
