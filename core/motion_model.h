@@ -30,13 +30,14 @@ struct MotionState {
 // x and y, (rad/s³)²·s for yaw. `filter.jerk_sigma_mps3` is its square root.
 using JerkDensity = std::array<double, kMotionAxes>;
 
-// Propagates `in` by dt_s seconds (either sign; the added noise grows with
-// |dt|) into `out` (may alias `in` only if they are distinct objects: pass a
-// copy). Only the first `orders` derivative orders of `out` are computed
-// (1: pose, 2: pose and rates, 3: all); the rest of `out` is left unchanged.
-// The yaw is not wrapped.
-inline void propagate_motion(const MotionState& in, double dt_s, const JerkDensity& jerk,
-                             MotionState* out, int orders = kMotionOrders) {
+// Propagates state x / covariance p (row-major kMotionStates²) by dt_s
+// seconds (either sign; the added noise grows with |dt|) into x_out / p_out,
+// which must not overlap the inputs. Only the first `orders` derivative
+// orders are written (1: pose, 2: pose and rates, 3: all); the rest of the
+// outputs is left as it was. The yaw is not wrapped. On raw arrays so that
+// the pose client carries a shared-memory record without copying it.
+inline void propagate_motion(const double* x, const double* p, double dt_s, const JerkDensity& jerk,
+                             double* x_out, double* p_out, int orders = kMotionOrders) {
   constexpr int A = kMotionAxes;
   constexpr int N = kMotionStates;
   // Row k of F maps order k from orders k..2 with c = [1, dt, dt²/2].
@@ -44,23 +45,26 @@ inline void propagate_motion(const MotionState& in, double dt_s, const JerkDensi
   for (int i = 0; i < orders; ++i)
     for (int a = 0; a < A; ++a) {
       double sum = 0.0;
-      for (int k = i; k < kMotionOrders; ++k) sum += c[k - i] * in.x[k * A + a];
-      out->x[i * A + a] = sum;
+      for (int k = i; k < kMotionOrders; ++k) sum += c[k - i] * x[k * A + a];
+      x_out[i * A + a] = sum;
     }
-  // P' block (i, j) = Σ_{k≥i, l≥j} c[k-i] c[l-j] P block (k, l).
-  for (int i = 0; i < orders; ++i)
+  // P' block (i, j) = Σ_{k≥i} c[k-i] (Σ_{l≥j} c[l-j] P block (k, l)): the
+  // inner sum (P Fᵀ) once per row, then F from the left.
+  double pf[N][N];
+  for (int r = 0; r < N; ++r)
     for (int j = 0; j < orders; ++j)
-      for (int a = 0; a < A; ++a)
-        for (int b = 0; b < A; ++b) {
-          double sum = 0.0;
-          for (int k = i; k < kMotionOrders; ++k) {
-            double row = 0.0;
-            for (int l = j; l < kMotionOrders; ++l)
-              row += c[l - j] * in.p[(k * A + a) * N + l * A + b];
-            sum += c[k - i] * row;
-          }
-          out->p[(i * A + a) * N + j * A + b] = sum;
-        }
+      for (int b = 0; b < A; ++b) {
+        double sum = 0.0;
+        for (int l = j; l < kMotionOrders; ++l) sum += c[l - j] * p[r * N + l * A + b];
+        pf[r][j * A + b] = sum;
+      }
+  for (int i = 0; i < orders; ++i)
+    for (int a = 0; a < A; ++a)
+      for (int col = 0; col < orders * A; ++col) {
+        double sum = 0.0;
+        for (int k = i; k < kMotionOrders; ++k) sum += c[k - i] * pf[k * A + a][col];
+        p_out[(i * A + a) * N + col] = sum;
+      }
   // White jerk, integrated over |dt|: q·[t⁵/20 t⁴/8 t³/6; t⁴/8 t³/3 t²/2; t³/6 t²/2 t].
   const double t = std::abs(dt_s);
   const double t2 = t * t, t3 = t2 * t;
@@ -69,7 +73,12 @@ inline void propagate_motion(const MotionState& in, double dt_s, const JerkDensi
                                                   {t3 / 6.0, t2 / 2.0, t}};
   for (int i = 0; i < orders; ++i)
     for (int j = 0; j < orders; ++j)
-      for (int a = 0; a < A; ++a) out->p[(i * A + a) * N + j * A + a] += jerk[a] * q[i][j];
+      for (int a = 0; a < A; ++a) p_out[(i * A + a) * N + j * A + a] += jerk[a] * q[i][j];
+}
+
+inline void propagate_motion(const MotionState& in, double dt_s, const JerkDensity& jerk,
+                             MotionState* out, int orders = kMotionOrders) {
+  propagate_motion(in.x.data(), in.p.data(), dt_s, jerk, out->x.data(), out->p.data(), orders);
 }
 
 // The filter's belief at one instant, with the noise needed to carry it to

@@ -9,6 +9,8 @@
 //                            process spinning on read_latest() sees it after ...
 //   BM_FutexWake             writer process publishes every 1 ms; a reader
 //                            blocked in wait_next() returns after ...
+//   BM_Predict               one ceilpose_client_predict() (the C API: read the
+//                            latest pose, carry it 33 ms ahead) on an idle writer
 #include <benchmark/benchmark.h>
 #include <signal.h>
 #include <sys/wait.h>
@@ -20,6 +22,7 @@
 #include <string>
 #include <vector>
 
+#include "ceilpose/pose_client.h"
 #include "core/clock.h"
 #include "ipc/shm/shm_pose_reader.h"
 #include "ipc/shm/shm_pose_writer.h"
@@ -142,6 +145,39 @@ void BM_ReadLatest(benchmark::State& state) {
 }
 // Samples include two clock reads (~20-40 ns): the figures are upper bounds.
 BENCHMARK(BM_ReadLatest)->Arg(0)->Arg(1000)->Arg(-1)->Iterations(2'000'000)->UseRealTime();
+
+void BM_Predict(benchmark::State& state) {
+  const std::string name = bench_shm_name("predict");
+  ShmOptions options;
+  options.name = name;
+  auto writer = ShmPoseWriter::create(options);
+  if (!writer) return state.SkipWithError(writer.error().message.c_str());
+  PoseRecord p{};
+  p.flags = kPoseValid | kPoseFiltered;
+  p.capture_mono_ns = monotonic_ns();
+  MotionEstimate m;
+  m.valid = true;
+  m.time_ns = p.capture_mono_ns;
+  m.state.x = {1.0, 2.0, 0.5, 1.2, 0.3, 0.8, 0.5, -0.4, 0.1};
+  for (int i = 0; i < kMotionStates; ++i) m.state.p[i * kMotionStates + i] = 1e-4;
+  m.jerk = {100.0, 100.0, 90000.0};
+  m.horizon_ms = 200.0;
+  set_pose_motion(&p, m);
+  writer->publish(p);
+  ceilpose_client* client = nullptr;
+  if (ceilpose_client_open(name.c_str(), &client) != CEILPOSE_OK)
+    return state.SkipWithError(ceilpose_last_error_message());
+  ceilpose_pose out;
+  const int64_t t_ns = p.capture_mono_ns + 33'000'000;
+  for (auto _ : state) {
+    const int rc = ceilpose_client_predict(client, t_ns, &out);
+    benchmark::DoNotOptimize(rc);
+    benchmark::DoNotOptimize(out);
+  }
+  ceilpose_client_close(client);
+  (void)ShmPoseWriter::remove(name);
+}
+BENCHMARK(BM_Predict);
 
 void BM_Publish(benchmark::State& state) {
   const std::string name = bench_shm_name("publish");
