@@ -16,7 +16,9 @@ Result<void> load_calibration_files(const CalibrationFiles& files, const std::st
     auto size =
         check_calibration_size(*read, files.camera_file, camera.width, camera.height, capture);
     if (!size) return size;
+    const double readout_ms = camera.readout_ms;  // a camera_info has no row timing
     camera = *read;
+    camera.readout_ms = readout_ms;
   }
   std::shared_ptr<const CeilingMap> map;
   if (!files.map_file.empty()) {

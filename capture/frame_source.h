@@ -60,6 +60,10 @@ struct SourceOptions {
   // The pipeline holds one, the ring a few, the driver needs at least one.
   int buffer_count = 4;
   ControlLocks controls;
+  // Rolling-shutter readout, first row to last, milliseconds (camera.readout_ms;
+  // 0 = global shutter): live sources stamp frames at the centre row's
+  // mid-exposure (capture/exposure_timing.h).
+  double readout_ms = 0.0;
 
   // Recovery of live devices: no frame for stall_timeout_ms counts as a stall;
   // reopen attempts back off exponentially from reconnect_initial_ms up to

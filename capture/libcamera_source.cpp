@@ -6,8 +6,10 @@
 
 #include <cerrno>
 #include <chrono>
+#include <cmath>
 #include <cstring>
 
+#include "capture/exposure_timing.h"
 #include "core/clock.h"
 
 namespace ceilpose::capture {
@@ -227,8 +229,18 @@ NextStatus LibcameraSource::do_next(Frame* out, int timeout_ms) {
                       stride_bytes_,
                       format_,
                       buffer->planes()[0].length};
-  const auto sensor_ns = request->metadata().get(lc::controls::SensorTimestamp);
-  f.capture_ns = sensor_ns ? *sensor_ns : static_cast<int64_t>(buffer->metadata().timestamp);
+  // SensorTimestamp marks the first row's readout on CLOCK_BOOTTIME; the
+  // buffer's own timestamp (pipelines without it) is the V4L2 end-of-frame
+  // stamp on CLOCK_MONOTONIC. Either becomes the centre row's mid-exposure.
+  const lc::ControlList& meta = request->metadata();
+  const auto sensor_ns = meta.get(lc::controls::SensorTimestamp);
+  const auto exposure_us = meta.get(lc::controls::ExposureTime);
+  const int64_t exposure_ns = exposure_us ? int64_t{*exposure_us} * 1000 : 0;
+  const int64_t readout_ns = std::llround(options_.readout_ms * 1e6);
+  f.capture_ns = sensor_ns ? exposure_mid_ns(*sensor_ns - boottime_minus_monotonic_ns(),
+                                             StampEvent::kStartOfFrame, exposure_ns, readout_ns)
+                           : exposure_mid_ns(static_cast<int64_t>(buffer->metadata().timestamp),
+                                             StampEvent::kEndOfFrame, exposure_ns, readout_ns);
   f.dequeue_ns = dequeue_ns;
   f.source_timestamp_ns = f.capture_ns;
   f.sequence = sequence_++;

@@ -81,9 +81,13 @@ V4l2Source::~V4l2Source() {
 std::string V4l2Source::describe() const {
   if (width_ == 0) return "v4l2:" + path_ + " (not open)";
   char text[160];
-  std::snprintf(text, sizeof text, " %dx%d %s %.1f fps, %d buffers%s", width_, height_,
-                to_string(format_), fps_, options_.buffer_count,
-                driver_timestamps_ ? "" : ", dequeue-time timestamps");
+  const char* stamps = !driver_timestamps_                            ? "dequeue-time stamps"
+                       : stamp_event_ == StampEvent::kStartOfExposure ? "start-of-exposure stamps"
+                                                                      : "end-of-frame stamps";
+  std::snprintf(text, sizeof text,
+                " %dx%d %s %.1f fps, %d buffers, %s, exposure %.1f ms, readout %.1f ms", width_,
+                height_, to_string(format_), fps_, options_.buffer_count, stamps,
+                static_cast<double>(exposure_ns_) * 1e-6, options_.readout_ms);
   return "v4l2:" + path_ + text;
 }
 
@@ -256,6 +260,8 @@ void V4l2Source::lock_controls() {
 
 Result<void> V4l2Source::do_start() {
   if (auto r = start_streaming(); !r) return r;
+  frames_since_exposure_read_ = 0;
+  (void)exposure_ns();  // for the line below; re-read as frames come
   spdlog::info("{}: streaming {}", path_, describe());
   return {};
 }
@@ -433,6 +439,29 @@ NextStatus V4l2Source::do_next(Frame* out, int timeout_ms) {
   }
 }
 
+// The exposure time of the frames being dequeued, for their mid-exposure
+// stamp: the driver's exposure_absolute (100 µs units; the locked value, or
+// auto exposure's current one), re-read every kExposureRefreshFrames so that
+// auto exposure is followed at a syscall per second. 0 when the driver has no
+// such control (said once).
+int64_t V4l2Source::exposure_ns() {
+  if (frames_since_exposure_read_++ % kExposureRefreshFrames != 0) return exposure_ns_;
+  v4l2_control ctrl{V4L2_CID_EXPOSURE_ABSOLUTE, 0};
+  if (sys_->ioctl(fd_.get(), VIDIOC_G_CTRL, &ctrl) == 0 && ctrl.value > 0) {
+    exposure_ns_ = int64_t{ctrl.value} * 100'000;
+  } else {
+    if (!warned_exposure_) {
+      spdlog::info(
+          "{}: no exposure_absolute control: frame times are the driver's stamps moved by "
+          "half the readout only, not by half the (unknown) exposure",
+          path_);
+      warned_exposure_ = true;
+    }
+    exposure_ns_ = 0;
+  }
+  return exposure_ns_;
+}
+
 NextStatus V4l2Source::dequeue(Frame* out) {
   v4l2_buffer buf{};
   buf.type = V4L2_BUF_TYPE_VIDEO_CAPTURE;
@@ -479,8 +508,14 @@ NextStatus V4l2Source::dequeue(Frame* out) {
                         format_,
                         buf.bytesused};
   }
+  // The driver stamps the start of exposure or the end of the frame (the
+  // default); the frame's time is the centre row's mid-exposure.
+  StampEvent event = (buf.flags & V4L2_BUF_FLAG_TSTAMP_SRC_MASK) == V4L2_BUF_FLAG_TSTAMP_SRC_SOE
+                         ? StampEvent::kStartOfExposure
+                         : StampEvent::kEndOfFrame;
+  int64_t stamp_ns = 0;
   if ((buf.flags & V4L2_BUF_FLAG_TIMESTAMP_MASK) == V4L2_BUF_FLAG_TIMESTAMP_MONOTONIC) {
-    f.capture_ns = timeval_ns(buf.timestamp);
+    stamp_ns = timeval_ns(buf.timestamp);
   } else {
     if (!warned_timestamps_) {
       // Once per source, not per frame.
@@ -491,8 +526,11 @@ NextStatus V4l2Source::dequeue(Frame* out) {
       warned_timestamps_ = true;
     }
     driver_timestamps_ = false;
-    f.capture_ns = dequeue_ns;
+    stamp_ns = dequeue_ns;  // after the end of the frame, by the queueing delay
+    event = StampEvent::kEndOfFrame;
   }
+  stamp_event_ = event;
+  f.capture_ns = exposure_mid_ns(stamp_ns, event, exposure_ns(), readout_ns_);
   f.dequeue_ns = dequeue_ns;
   f.source_timestamp_ns = f.capture_ns;
   f.sequence = sequence_++;

@@ -1,7 +1,9 @@
 #pragma once
 // V4L2 camera (v4l2:/dev/videoN): mmap streaming, format negotiation, locked
-// exposure/gain/white balance, driver timestamps on CLOCK_MONOTONIC, and
-// recovery from a device that vanishes, errors or stalls.
+// exposure/gain/white balance, driver timestamps on CLOCK_MONOTONIC moved to
+// the centre row's mid-exposure (start-of-exposure or end-of-frame stamps,
+// exposure_absolute, camera.readout_ms), and recovery from a device that vanishes, errors or
+// stalls.
 //
 // Zero-copy for raw formats (YUYV, RGB24, BGR24, GREY): a frame's image points
 // into the mmap'd driver buffer, which is re-queued only on release(). MJPEG is
@@ -16,10 +18,12 @@
 // across an outage stay mapped until they are released.
 //
 // Threads: see FrameSource; one thread (the capture thread) only.
+#include <cmath>
 #include <cstdint>
 #include <string>
 #include <vector>
 
+#include "capture/exposure_timing.h"
 #include "capture/frame_source.h"
 #include "capture/v4l2_syscalls.h"
 
@@ -92,6 +96,14 @@ class V4l2Source final : public FrameSource {
   double fps_ = 0.0;
   bool driver_timestamps_ = true;
   bool warned_timestamps_ = false;
+  // Mid-exposure stamps (capture/exposure_timing.h).
+  static constexpr uint32_t kExposureRefreshFrames = 30;
+  int64_t exposure_ns();
+  const int64_t readout_ns_ = std::llround(options_.readout_ms * 1e6);
+  StampEvent stamp_event_ = StampEvent::kEndOfFrame;
+  int64_t exposure_ns_ = 0;
+  uint32_t frames_since_exposure_read_ = 0;
+  bool warned_exposure_ = false;
   bool reported_controls_ = false;
 
   std::vector<Buffer> buffers_;

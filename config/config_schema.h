@@ -63,6 +63,7 @@ void describe(V& v, ServiceConfig& c) {
     v.field("cx", k.cx, -1e5, 1e5);
     v.field("cy", k.cy, -1e5, 1e5);
     v.numbers("distortion", k.distortion);
+    v.field("readout_ms", k.readout_ms, 0.0, 1000.0);
     v.text("calibration_file", c.calibration.camera_file, check_any_text);
   });
   v.section("mount", [&] {

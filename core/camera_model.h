@@ -18,6 +18,9 @@ struct CameraIntrinsics {
   double cx = 319.5;
   double cy = 239.5;
   std::array<double, 5> distortion{0.0, 0.0, 0.0, 0.0, 0.0};  // k1 k2 p1 p2 k3
+  // Rolling shutter (SPEC §3): first row to last, milliseconds; 0 = global.
+  // Not part of a camera_info calibration (§9): a calibration keeps it.
+  double readout_ms = 0.0;
 
   bool has_distortion() const;
   bool operator==(const CameraIntrinsics&) const = default;

@@ -54,6 +54,7 @@ capture::SourceOptions source_options(const ServiceConfig& c) {
   capture::SourceOptions o = c.capture.device;
   o.width = c.pipeline.intrinsics.width;
   o.height = c.pipeline.intrinsics.height;
+  o.readout_ms = c.pipeline.intrinsics.readout_ms;
   return o;
 }
 

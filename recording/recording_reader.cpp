@@ -168,6 +168,16 @@ Result<RecordingCamera> parse_yaml(const std::string& path) {
       k.distortion[static_cast<size_t>(c)] = v;
     }
   }
+  // readout_ms is optional (SPEC §3: absent means a global shutter).
+  if (const YAML::Node readout = cam["readout_ms"]; readout.IsDefined() && !readout.IsNull()) {
+    auto v = yaml_scalar<double>(cam, "camera", "readout_ms", path, "a number of milliseconds");
+    if (!v) return v.error();
+    if (!std::isfinite(*v) || *v < 0.0 || *v > 1000.0) {
+      return make_error(path + ":" + std::to_string(line_of(readout)) +
+                        ": key 'camera.readout_ms' must be 0 to 1000 ms");
+    }
+    k.readout_ms = *v;
+  }
   const YAML::Node source = root["source"];
   if (source.IsDefined() && !source.IsNull()) {
     if (!source.IsScalar()) {

@@ -76,6 +76,7 @@ std::string yaml_text(const RecordingCamera& camera) {
     y += number_text(k.distortion[c]);
   }
   y += "]   # k1 k2 p1 p2 k3\n";
+  y += "  readout_ms: " + number_text(k.readout_ms) + "   # rolling-shutter readout, 0 = global\n";
   if (!camera.source.empty()) y += "source: " + yaml_quoted(camera.source) + "\n";
   return y;
 }

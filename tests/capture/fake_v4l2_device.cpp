@@ -90,6 +90,11 @@ std::vector<uint32_t> FakeV4l2Device::queue_order() const {
   std::lock_guard<std::mutex> lock(mutex_);
   return queue_order_;
 }
+
+std::vector<int64_t> FakeV4l2Device::stamps_written() const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  return stamps_;
+}
 uint64_t FakeV4l2Device::stamp_of(const uint8_t* data) {
   uint64_t v;
   std::memcpy(&v, data, sizeof v);
@@ -179,7 +184,10 @@ bool FakeV4l2Device::produce_locked() {
   b.info.timestamp.tv_sec = static_cast<time_t>(now_ns / 1'000'000'000);
   b.info.timestamp.tv_usec = static_cast<suseconds_t>((now_ns % 1'000'000'000) / 1000);
   b.info.flags =
-      monotonic_timestamps ? V4L2_BUF_FLAG_TIMESTAMP_MONOTONIC : V4L2_BUF_FLAG_TIMESTAMP_UNKNOWN;
+      (monotonic_timestamps ? V4L2_BUF_FLAG_TIMESTAMP_MONOTONIC : V4L2_BUF_FLAG_TIMESTAMP_UNKNOWN) |
+      timestamp_source;
+  stamps_.push_back(static_cast<int64_t>(b.info.timestamp.tv_sec) * 1'000'000'000 +
+                    static_cast<int64_t>(b.info.timestamp.tv_usec) * 1000);
   b.info.sequence = sequence_++;
   if (sequence_gap_after.count(frame)) ++sequence_;
   b.info.reserved = static_cast<uint32_t>(frame);  // the frame number, for fault lookup

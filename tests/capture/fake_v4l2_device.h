@@ -41,6 +41,9 @@ class FakeV4l2Device : public V4l2Syscalls {
   uint32_t max_height = 1080;
   bool timeperframe = true;
   bool monotonic_timestamps = true;
+  // What the stamps mark: V4L2_BUF_FLAG_TSTAMP_SRC_EOF (end of frame, most
+  // drivers) or V4L2_BUF_FLAG_TSTAMP_SRC_SOE (start of exposure).
+  uint32_t timestamp_source = V4L2_BUF_FLAG_TSTAMP_SRC_EOF;
   std::map<uint32_t, Control> controls;  // present controls; absent ids answer EINVAL
   // Frame numbers (0-based, in production order) after which the driver skips
   // one sequence number, as a driver that lost a frame does.
@@ -71,6 +74,8 @@ class FakeV4l2Device : public V4l2Syscalls {
   // Indices in the order DQBUF handed them out / QBUF got them back.
   std::vector<uint32_t> dequeue_order() const;
   std::vector<uint32_t> queue_order() const;
+  // The stamp of every frame produced, as the driver wrote it (µs resolution).
+  std::vector<int64_t> stamps_written() const;
   // Reads the frame number the fake wrote into a buffer's first 8 bytes.
   static uint64_t stamp_of(const uint8_t* data);
 
@@ -120,6 +125,7 @@ class FakeV4l2Device : public V4l2Syscalls {
   std::set<uint64_t> stall_at_;
   std::vector<uint32_t> dequeue_order_;
   std::vector<uint32_t> queue_order_;
+  std::vector<int64_t> stamps_;
 };
 
 }  // namespace ceilpose::capture::testing

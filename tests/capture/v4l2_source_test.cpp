@@ -206,6 +206,79 @@ TEST(V4l2Source, MonotonicDriverTimestampsBecomeCaptureTime) {
   EXPECT_LE(f.capture_ns, f.dequeue_ns);
 }
 
+// Issue 13: a frame's time is its centre row's mid-exposure, whichever
+// event the driver stamps.
+struct StampCase {
+  uint32_t source_flag;
+  bool exposure_control;
+  int64_t expected_shift_ns;  // capture_ns minus the driver's stamp
+};
+
+class V4l2Stamps : public ::testing::TestWithParam<StampCase> {};
+
+TEST_P(V4l2Stamps, CaptureTimeIsTheCentreRowsMidExposure) {
+  const StampCase c = GetParam();
+  FakeV4l2Device dev;
+  dev.timestamp_source = c.source_flag;
+  if (c.exposure_control) dev.controls[V4L2_CID_EXPOSURE_ABSOLUTE] = {1, 5000, 100};  // 10 ms
+  SourceOptions options = fast_recovery_options();
+  options.readout_ms = 20.0;
+  options.controls.lock_exposure = false;  // the driver's value counts
+  V4l2Source source("/dev/video0", options, &dev);
+  open_and_start(source);
+  for (int k = 0; k < 3; ++k) {
+    Frame f;
+    ASSERT_TRUE(next_frame(source, &f));
+    ASSERT_EQ(dev.stamps_written().size(), static_cast<size_t>(k + 1));
+    EXPECT_EQ(f.capture_ns - dev.stamps_written()[static_cast<size_t>(k)], c.expected_shift_ns);
+    source.release(f);
+  }
+  const bool soe = c.source_flag == V4L2_BUF_FLAG_TSTAMP_SRC_SOE;
+  EXPECT_NE(source.describe().find(soe ? "start-of-exposure" : "end-of-frame"), std::string::npos)
+      << source.describe();
+}
+
+INSTANTIATE_TEST_SUITE_P(Kinds, V4l2Stamps,
+                         ::testing::Values(
+                             // End of frame: back by half the exposure and half the readout.
+                             StampCase{V4L2_BUF_FLAG_TSTAMP_SRC_EOF, true, -5'000'000 - 10'000'000},
+                             // Start of exposure: forward by the same.
+                             StampCase{V4L2_BUF_FLAG_TSTAMP_SRC_SOE, true, 5'000'000 + 10'000'000},
+                             // No exposure control: only the readout is known.
+                             StampCase{V4L2_BUF_FLAG_TSTAMP_SRC_EOF, false, -10'000'000}));
+
+TEST(V4l2Source, ALockedExposureIsTheOneTheStampsUse) {
+  FakeV4l2Device dev;
+  dev.controls[V4L2_CID_EXPOSURE_ABSOLUTE] = {1, 5000, 100};
+  SourceOptions options = fast_recovery_options();
+  options.controls.exposure_us = 4000;  // locked (the default) at 4 ms
+  V4l2Source source("/dev/video0", options, &dev);
+  open_and_start(source);
+  Frame f;
+  ASSERT_TRUE(next_frame(source, &f));
+  EXPECT_EQ(f.capture_ns - dev.stamps_written().back(), -2'000'000);
+}
+
+TEST(V4l2Source, AutoExposureIsFollowedForTheStamps) {
+  FakeV4l2Device dev;
+  dev.controls[V4L2_CID_EXPOSURE_ABSOLUTE] = {1, 5000, 100};  // 10 ms
+  SourceOptions options = fast_recovery_options();
+  options.controls.lock_exposure = false;
+  V4l2Source source("/dev/video0", options, &dev);
+  open_and_start(source);
+  EXPECT_NE(source.describe().find("exposure 10.0 ms"), std::string::npos) << source.describe();
+  ASSERT_TRUE(stream_frames(source, 1));
+  dev.controls[V4L2_CID_EXPOSURE_ABSOLUTE].value = 300;  // auto exposure: 30 ms
+  int64_t shift_ns = 0;
+  for (int k = 1; k <= 60; ++k) {
+    Frame f;
+    ASSERT_TRUE(next_frame(source, &f));
+    shift_ns = f.capture_ns - dev.stamps_written().back();
+    source.release(f);
+  }
+  EXPECT_EQ(shift_ns, -15'000'000) << "within a second the new exposure counts";
+}
+
 TEST(V4l2Source, NonMonotonicDriverTimestampsFallBackToDequeueTime) {
   FakeV4l2Device dev;
   dev.monotonic_timestamps = false;
@@ -216,6 +289,7 @@ TEST(V4l2Source, NonMonotonicDriverTimestampsFallBackToDequeueTime) {
   EXPECT_FALSE(source.driver_timestamps());
   EXPECT_EQ(f.capture_ns, f.dequeue_ns);
   EXPECT_NE(source.describe().find("dequeue-time"), std::string::npos) << source.describe();
+  // Dequeue time is after the end of the frame: it moves back like an end-of-frame stamp.
 }
 
 TEST(V4l2Source, DriverSequenceGapsAreCountedAsDrops) {

@@ -57,6 +57,7 @@ TEST_F(RecordingReaderTest, ReadsHandWrittenRecordingInSpecFormat) {
   EXPECT_EQ(k.height, 480);
   EXPECT_DOUBLE_EQ(k.fx, 530.0);
   EXPECT_DOUBLE_EQ(k.cy, 239.5);
+  EXPECT_EQ(k.readout_ms, 0.0) << "absent: a global shutter";
   EXPECT_EQ(reader_->camera().source, "free text: synthetic, v4l2 device, ...");
   ASSERT_EQ(reader_->rows().size(), 1u);
   const RecordingRow& row = reader_->rows()[0];

@@ -54,6 +54,7 @@ RecordingCamera test_camera(int width, int height) {
   cam.intrinsics.cx = (width - 1) * 0.5;
   cam.intrinsics.cy = (height - 1) * 0.5;
   cam.intrinsics.distortion = {-0.1, 0.01, 0.001, -0.002, 0.0005};
+  cam.intrinsics.readout_ms = 12.5;
   cam.source = "unit test \"pattern\"";
   return cam;
 }
@@ -157,7 +158,8 @@ std::vector<MalformedCase> make_cases() {
   auto yaml = [](const std::string& dir) { return dir + "/recording.yaml"; };
   auto csv = [](const std::string& dir) { return dir + "/frames.csv"; };
   // Lines of the writer's recording.yaml: 1 format, 2 version, 3 camera:,
-  // 4 width, 5 height, 6 fx, 7 fy, 8 cx, 9 cy, 10 distortion, 11 source.
+  // 4 width, 5 height, 6 fx, 7 fy, 8 cx, 9 cy, 10 distortion, 11 readout_ms,
+  // 12 source.
   c.push_back({"MissingRecordingYaml",
                png,
                [=](const std::string& d) { fs::remove(yaml(d)); },
@@ -194,6 +196,10 @@ std::vector<MalformedCase> make_cases() {
                png,
                [=](const std::string& d) { replace_line(yaml(d), 10, "  distortion: [0.1, 0]"); },
                {"recording.yaml:10", "distortion"}});
+  c.push_back({"NegativeReadout",
+               png,
+               [=](const std::string& d) { replace_line(yaml(d), 11, "  readout_ms: -3"); },
+               {"recording.yaml:11", "'camera.readout_ms'", "0 to 1000 ms"}});
   c.push_back({"MissingFramesCsv",
                png,
                [=](const std::string& d) { fs::remove(csv(d)); },

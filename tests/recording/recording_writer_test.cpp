@@ -70,6 +70,7 @@ TEST_P(LosslessRoundTrip, ReadsBackIdenticalPixelsAndRows) {
   EXPECT_EQ(k.cx, expected_cam.intrinsics.cx);
   EXPECT_EQ(k.cy, expected_cam.intrinsics.cy);
   EXPECT_EQ(k.distortion, expected_cam.intrinsics.distortion);
+  EXPECT_EQ(k.readout_ms, 12.5);
   EXPECT_EQ(reader->camera().source, expected_cam.source);
   EXPECT_EQ(reader->has_ground_truth_columns(), p.ground_truth);
   ASSERT_EQ(reader->rows().size(), 4u);
