@@ -13,6 +13,14 @@ void DdsPoseSink::consume(const Localization& loc) {
   pose.valid = true;
   pose.pose = loc.published.pose;
   pose.covariance = loc.published.covariance;
+  pose.has_velocity = loc.motion.valid;
+  if (pose.has_velocity) {
+    const MotionState& s = loc.motion.state;
+    pose.velocity = {s.x[3], s.x[4], s.x[5]};
+    for (int r = 0; r < 3; ++r)
+      for (int c = 0; c < 3; ++c)
+        pose.velocity_covariance[r * 3 + c] = s.p[(3 + r) * kMotionStates + 3 + c];
+  }
   if (!publisher_->publish(pose)) failures_.fetch_add(1, std::memory_order_relaxed);
 }
 

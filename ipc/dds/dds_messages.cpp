@@ -53,6 +53,43 @@ void to_message(const DdsPose& pose, geometry_msgs_msg_dds__PoseWithCovarianceSt
   }
 }
 
+void to_message(const DdsPose& pose, nav_msgs_msg_dds__Odometry_* msg) {
+  geometry_msgs_msg_dds__PoseWithCovarianceStamped_ stamped;
+  to_message(pose, &stamped);
+  msg->header = stamped.header;
+  msg->pose = stamped.pose;
+  msg->child_frame_id = const_cast<char*>(kBaseFrame);
+  auto& t = msg->twist;
+  for (double& v : t.covariance) v = 0.0;
+  t.twist.linear = {0.0, 0.0, 0.0};
+  t.twist.angular = {0.0, 0.0, 0.0};
+  if (!pose.has_velocity) {
+    for (int i = 0; i < 6; ++i) t.covariance[i * 6 + i] = kUnobservedVariance;
+    return;
+  }
+  // World to base_link: R(-yaw) on (vx, vy); the yaw rate is the same in both.
+  const double c = std::cos(pose.pose.yaw_rad), s = std::sin(pose.pose.yaw_rad);
+  const double r[3][3] = {{c, s, 0.0}, {-s, c, 0.0}, {0.0, 0.0, 1.0}};
+  double body[3] = {};
+  for (int i = 0; i < 3; ++i)
+    for (int k = 0; k < 3; ++k) body[i] += r[i][k] * pose.velocity[k];
+  t.twist.linear.x = body[0];
+  t.twist.linear.y = body[1];
+  t.twist.angular.z = body[2];
+  // R Σ Rᵀ into rows/columns (vx, vy, rate about z) of the 6x6; vz, roll and
+  // pitch rates are unobserved.
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j) {
+      double sum = 0.0;
+      for (int k = 0; k < 3; ++k)
+        for (int l = 0; l < 3; ++l) sum += r[i][k] * pose.velocity_covariance[k * 3 + l] * r[j][l];
+      t.covariance[kPlanarIndex[i] * 6 + kPlanarIndex[j]] = sum;
+    }
+  t.covariance[2 * 6 + 2] = kUnobservedVariance;
+  t.covariance[3 * 6 + 3] = kUnobservedVariance;
+  t.covariance[4 * 6 + 4] = kUnobservedVariance;
+}
+
 DdsPose from_message(const geometry_msgs_msg_dds__PoseWithCovarianceStamped_& msg) {
   DdsPose out;
   out.valid = true;

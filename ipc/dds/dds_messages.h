@@ -17,6 +17,11 @@ struct DdsPose {
   bool valid = false;                  // invalid poses are never published
   Pose2D pose;                         // in `map`
   std::array<double, 9> covariance{};  // (x_m, y_m, yaw_rad), row-major, SI units squared
+  // The filter's motion, world frame (`map`): vx_mps, vy_mps, yaw_rate_radps
+  // and their covariance; without it the Odometry twist is marked unknown.
+  bool has_velocity = false;
+  std::array<double, 3> velocity{};
+  std::array<double, 9> velocity_covariance{};
 };
 
 enum class DdsHealth : uint8_t { kOk = 0, kDegraded = 1, kFailed = 2 };
@@ -44,11 +49,20 @@ inline constexpr double kUnobservedVariance = 1e6;
 
 // The frame every pose is expressed in (SPEC §7).
 inline constexpr char kMapFrame[] = "map";
+// The robot's own frame, Odometry's child_frame_id (REP-105).
+inline constexpr char kBaseFrame[] = "base_link";
 
 // Fills `msg` without allocating: header.frame_id points at kMapFrame.
 // Stamp = capture time split into sec/nanosec; position (x, y, 0);
 // orientation = rotation by yaw about z; covariance as described in the .cpp.
 void to_message(const DdsPose& pose, geometry_msgs_msg_dds__PoseWithCovarianceStamped_* msg);
+
+// nav_msgs/Odometry for robot_localization: the same pose and header, child
+// frame base_link, and the twist in base_link as REP-105 says (forward,
+// left, yaw rate: the world velocity rotated by -yaw, its covariance by the
+// same rotation). Without a velocity the twist is zero with
+// kUnobservedVariance on its diagonal: unknown, not "standing still".
+void to_message(const DdsPose& pose, nav_msgs_msg_dds__Odometry_* msg);
 
 // The inverse for a received message: yaw is taken from the full quaternion,
 // the covariance from the (x, y, rot_z) rows and columns.

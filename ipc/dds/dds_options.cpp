@@ -55,6 +55,8 @@ std::string status_topic_name(std::string_view robot) {
   return "rt/" + std::string(robot) + "/ceilpose_status";
 }
 
+std::string odom_topic_name(std::string_view robot) { return "rt/" + std::string(robot) + "/odom"; }
+
 std::string robot_from_pose_topic(std::string_view topic) {
   constexpr std::string_view kPrefix = "rt/";
   constexpr std::string_view kSuffix = "/pose";

@@ -51,6 +51,7 @@ std::string to_ros_name(std::string_view text);
 
 std::string pose_topic_name(std::string_view robot);    // "rt/<robot>/pose"
 std::string status_topic_name(std::string_view robot);  // "rt/<robot>/ceilpose_status"
+std::string odom_topic_name(std::string_view robot);    // "rt/<robot>/odom"
 
 // For a DDS topic name of the form rt/<robot>/pose returns <robot>, else empty.
 std::string robot_from_pose_topic(std::string_view topic);

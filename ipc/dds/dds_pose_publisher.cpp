@@ -49,6 +49,7 @@ Result<DdsPosePublisher> DdsPosePublisher::create(const DdsOptions& options) {
   pub.robot_ = options.robot;
   pub.pose_topic_ = pose_topic_name(options.robot);
   pub.status_topic_ = status_topic_name(options.robot);
+  pub.odom_topic_ = odom_topic_name(options.robot);
 
   auto pose_writer =
       create_writer(pub.participant_, &geometry_msgs_msg_dds__PoseWithCovarianceStamped__desc,
@@ -59,6 +60,10 @@ Result<DdsPosePublisher> DdsPosePublisher::create(const DdsOptions& options) {
       create_writer(pub.participant_, &ceilpose_msg_dds__Status__desc, pub.status_topic_, options);
   if (!status_writer) return status_writer.error();
   pub.status_writer_ = *status_writer;
+  auto odom_writer =
+      create_writer(pub.participant_, &nav_msgs_msg_dds__Odometry__desc, pub.odom_topic_, options);
+  if (!odom_writer) return odom_writer.error();
+  pub.odom_writer_ = *odom_writer;
   return pub;
 }
 
@@ -69,8 +74,12 @@ Result<void> DdsPosePublisher::publish(const DdsPose& pose) {
   if (!pose.valid) return make_error("refusing to publish an invalid pose on " + pose_topic_);
   geometry_msgs_msg_dds__PoseWithCovarianceStamped_ msg;
   to_message(pose, &msg);
-  const dds_return_t rc = dds_write(pose_writer_, &msg);
+  dds_return_t rc = dds_write(pose_writer_, &msg);
   if (rc != DDS_RETCODE_OK) return dds_error("cannot write a pose to " + pose_topic_, rc);
+  nav_msgs_msg_dds__Odometry_ odom;
+  to_message(pose, &odom);
+  rc = dds_write(odom_writer_, &odom);
+  if (rc != DDS_RETCODE_OK) return dds_error("cannot write odometry to " + odom_topic_, rc);
   ++published_;
   return {};
 }
@@ -88,6 +97,7 @@ void DdsPosePublisher::dispose() {
   participant_.reset();
   pose_writer_ = 0;
   status_writer_ = 0;
+  odom_writer_ = 0;
 }
 
 }  // namespace ceilpose

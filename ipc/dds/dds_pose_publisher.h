@@ -1,6 +1,7 @@
 #pragma once
 // Publishes a robot's poses as ROS 2 geometry_msgs/msg/PoseWithCovarianceStamped
-// on rt/<robot>/pose (ROS topic /<robot>/pose) and its health as
+// on rt/<robot>/pose (ROS topic /<robot>/pose), the same with the filter's
+// twist as nav_msgs/msg/Odometry on rt/<robot>/odom, and its health as
 // ceilpose/msg/Status on rt/<robot>/ceilpose_status, both XCDR1 as ROS 2
 // Humble/Iron expect.
 //
@@ -39,6 +40,7 @@ class DdsPosePublisher {
   const std::string& robot() const { return robot_; }
   const std::string& pose_topic() const { return pose_topic_; }
   const std::string& status_topic() const { return status_topic_; }
+  const std::string& odom_topic() const { return odom_topic_; }
   uint32_t domain_id() const { return participant_.domain_id(); }
   // For entities that should share this participant (one participant per
   // process is the cheapest for discovery); 0 after dispose().
@@ -51,9 +53,11 @@ class DdsPosePublisher {
   DdsParticipant participant_;
   dds_entity_t pose_writer_ = 0;  // children of participant_: deleted with it
   dds_entity_t status_writer_ = 0;
+  dds_entity_t odom_writer_ = 0;
   std::string robot_;
   std::string pose_topic_;
   std::string status_topic_;
+  std::string odom_topic_;
   uint64_t published_ = 0;
 };
 

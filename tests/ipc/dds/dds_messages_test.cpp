@@ -106,6 +106,37 @@ TEST(DdsMessages, YawNearPiSurvivesTheRoundTrip) {
   EXPECT_NEAR(from_message(msg).pose.yaw_rad, in.pose.yaw_rad, 1e-9);
 }
 
+TEST(DdsMessages, OdometryWithoutVelocityMarksTheTwistUnknown) {
+  DdsPose pose;
+  pose.valid = true;
+  pose.pose = {1.0, 2.0, 0.3};
+  nav_msgs_msg_dds__Odometry_ msg;
+  to_message(pose, &msg);
+  EXPECT_STREQ(msg.header.frame_id, "map");
+  EXPECT_STREQ(msg.child_frame_id, "base_link");
+  EXPECT_EQ(msg.pose.pose.position.x, 1.0);
+  EXPECT_EQ(msg.twist.twist.linear.x, 0.0);
+  for (int i = 0; i < 6; ++i) EXPECT_EQ(msg.twist.covariance[i * 6 + i], kUnobservedVariance);
+}
+
+TEST(DdsMessages, OdometryTwistIsInTheRobotsFrame) {
+  DdsPose pose;
+  pose.valid = true;
+  pose.pose = {0.0, 0.0, std::numbers::pi / 2};  // facing North
+  pose.has_velocity = true;
+  pose.velocity = {0.0, 1.5, -0.2};  // driving North, turning right
+  pose.velocity_covariance = {1e-4, 0.0, 0.0, 0.0, 4e-4, 0.0, 0.0, 0.0, 1e-3};
+  nav_msgs_msg_dds__Odometry_ msg;
+  to_message(pose, &msg);
+  EXPECT_NEAR(msg.twist.twist.linear.x, 1.5, 1e-12) << "straight ahead";
+  EXPECT_NEAR(msg.twist.twist.linear.y, 0.0, 1e-12);
+  EXPECT_EQ(msg.twist.twist.angular.z, -0.2);
+  // North's variance is now the forward one.
+  EXPECT_NEAR(msg.twist.covariance[0], 4e-4, 1e-15);
+  EXPECT_NEAR(msg.twist.covariance[7], 1e-4, 1e-15);
+  EXPECT_EQ(msg.twist.covariance[35], 1e-3);
+}
+
 TEST(DdsMessages, StatusCarriesRobotAndFigures) {
   DdsStatus s;
   s.publish_realtime_ns = 2'000'000'001;

@@ -6,6 +6,7 @@
 #include <cstdio>
 #include <ctime>
 #include <iostream>
+#include <vector>
 
 #include "core/clock.h"
 #include "ipc/dds/dds_pose_publisher.h"
@@ -22,6 +23,7 @@ int main(int argc, char** argv) {
   CLI::App app{"Publish a fake robot's pose on DDS (rt/<robot>/pose) for tests and demos."};
   DdsOptions options;
   double x_m = 0.0, y_m = 0.0, yaw_rad = 0.0, rate_hz = 50.0, duration_s = 30.0;
+  std::vector<double> velocity;
   int64_t stamp_ns = -1;
   bool best_effort = false;
   app.add_option("--robot", options.robot, "robot name (ROS name)")->required();
@@ -29,6 +31,9 @@ int main(int argc, char** argv) {
   app.add_option("--x", x_m, "x, metres");
   app.add_option("--y", y_m, "y, metres");
   app.add_option("--yaw", yaw_rad, "yaw, radians");
+  app.add_option("--velocity", velocity,
+                 "world-frame vx_mps vy_mps yaw_rate_radps (default: no velocity)")
+      ->expected(3);
   app.add_option("--rate", rate_hz, "poses per second")->check(CLI::Range(0.1, 10000.0));
   app.add_option("--duration", duration_s, "stop after this many seconds")
       ->check(CLI::Range(0.0, 3600.0));
@@ -54,6 +59,11 @@ int main(int argc, char** argv) {
   pose.valid = true;
   pose.pose = {x_m, y_m, yaw_rad};
   pose.covariance = {1e-4, 1e-5, 0.0, 1e-5, 2e-4, 0.0, 0.0, 0.0, 3e-3};
+  if (velocity.size() == 3) {
+    pose.has_velocity = true;
+    pose.velocity = {velocity[0], velocity[1], velocity[2]};
+    pose.velocity_covariance = {4e-4, 0.0, 0.0, 0.0, 1e-4, 0.0, 0.0, 0.0, 9e-4};
+  }
   DdsStatus status;
   status.fix = true;
   status.fps = static_cast<float>(rate_hz);

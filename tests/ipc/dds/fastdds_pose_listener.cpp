@@ -33,19 +33,26 @@ namespace {
 namespace fdds = eprosima::fastdds::dds;
 namespace frtps = eprosima::fastrtps::rtps;
 
+// geometry_msgs/PoseWithCovarianceStamped, or with `odom` nav_msgs/Odometry
+// (the same header and pose with child_frame_id between, then the twist).
 struct PoseMsg {
   int32_t sec = 0;
   uint32_t nanosec = 0;
   std::string frame_id;
+  std::string child_frame_id;
   double position[3] = {};
   double orientation[4] = {};
   double covariance[36] = {};
+  double linear[3] = {};
+  double angular[3] = {};
+  double twist_covariance[36] = {};
 };
 
 class PoseType : public fdds::TopicDataType {
  public:
-  PoseType() {
-    setName("geometry_msgs::msg::dds_::PoseWithCovarianceStamped_");
+  explicit PoseType(bool odom) : odom_(odom) {
+    setName(odom ? "nav_msgs::msg::dds_::Odometry_"
+                 : "geometry_msgs::msg::dds_::PoseWithCovarianceStamped_");
     m_typeSize = 4 + 8192;  // encapsulation + a generous bound (frame_id is a string)
     m_isGetKeyDefined = false;
   }
@@ -59,9 +66,15 @@ class PoseType : public fdds::TopicDataType {
         cdr.endianness() == eprosima::fastcdr::Cdr::BIG_ENDIANNESS ? CDR_BE : CDR_LE;
     cdr.serialize_encapsulation();
     cdr << msg->sec << msg->nanosec << msg->frame_id;
+    if (odom_) cdr << msg->child_frame_id;
     cdr.serializeArray(msg->position, 3);
     cdr.serializeArray(msg->orientation, 4);
     cdr.serializeArray(msg->covariance, 36);
+    if (odom_) {
+      cdr.serializeArray(msg->linear, 3);
+      cdr.serializeArray(msg->angular, 3);
+      cdr.serializeArray(msg->twist_covariance, 36);
+    }
     payload->length = static_cast<uint32_t>(cdr.getSerializedDataLength());
     return true;
   }
@@ -74,9 +87,20 @@ class PoseType : public fdds::TopicDataType {
     try {
       cdr.read_encapsulation();
       cdr >> msg->sec >> msg->nanosec >> msg->frame_id;
+      if (odom_) cdr >> msg->child_frame_id;
       cdr.deserializeArray(msg->position, 3);
       cdr.deserializeArray(msg->orientation, 4);
       cdr.deserializeArray(msg->covariance, 36);
+      if (odom_) {
+        cdr.deserializeArray(msg->linear, 3);
+        cdr.deserializeArray(msg->angular, 3);
+        cdr.deserializeArray(msg->twist_covariance, 36);
+      }
+      if (cdr.getSerializedDataLength() != payload->length) {
+        std::fprintf(stderr, "fastdds listener: %zu bytes left over in a sample\n",
+                     payload->length - cdr.getSerializedDataLength());
+        return false;
+      }
     } catch (const std::exception& e) {
       std::fprintf(stderr, "fastdds listener: cannot decode a sample: %s\n", e.what());
       return false;
@@ -90,6 +114,9 @@ class PoseType : public fdds::TopicDataType {
   void* createData() override { return new PoseMsg(); }
   void deleteData(void* data) override { delete static_cast<PoseMsg*>(data); }
   bool getKey(void*, frtps::InstanceHandle_t*, bool) override { return false; }
+
+ private:
+  bool odom_;
 };
 
 }  // namespace
@@ -99,6 +126,7 @@ int main(int argc, char** argv) {
   std::string topic_name;
   int count = 3;
   long timeout_ms = 20000;
+  bool odom = false;
   for (int k = 1; k + 1 < argc; k += 2) {
     if (std::strcmp(argv[k], "--domain") == 0)
       domain_id = std::atoi(argv[k + 1]);
@@ -108,10 +136,13 @@ int main(int argc, char** argv) {
       count = std::atoi(argv[k + 1]);
     else if (std::strcmp(argv[k], "--timeout-ms") == 0)
       timeout_ms = std::atol(argv[k + 1]);
+    else if (std::strcmp(argv[k], "--type") == 0)
+      odom = std::strcmp(argv[k + 1], "odom") == 0;
   }
   if (topic_name.empty()) {
     std::fprintf(stderr,
-                 "usage: %s --topic rt/<robot>/pose [--domain ID] [--count N] [--timeout-ms T]\n",
+                 "usage: %s --topic rt/<robot>/pose [--type pose|odom] [--domain ID] [--count N] "
+                 "[--timeout-ms T]\n",
                  argv[0]);
     return 2;
   }
@@ -135,7 +166,7 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "fastdds listener: cannot create a participant on domain %d\n", domain_id);
     return 1;
   }
-  fdds::TypeSupport type(new PoseType());
+  fdds::TypeSupport type(new PoseType(odom));
   type.register_type(participant);
   fdds::Topic* topic =
       participant->create_topic(topic_name, type.get_type_name(), fdds::TOPIC_QOS_DEFAULT);
@@ -170,6 +201,14 @@ int main(int argc, char** argv) {
           msg.position[1], msg.position[2], msg.orientation[0], msg.orientation[1],
           msg.orientation[2], msg.orientation[3], msg.covariance[0], msg.covariance[1],
           msg.covariance[7], msg.covariance[35], msg.covariance[14]);
+      if (odom) {
+        const double* t = msg.twist_covariance;
+        std::printf(
+            "odom child=%s vx=%.9g vy=%.9g vz=%.9g wx=%.9g wy=%.9g wz=%.9g tvxvx=%.9g tvxvy=%.9g "
+            "tvyvy=%.9g twzwz=%.9g tvxwz=%.9g tvzvz=%.9g twxwx=%.9g\n",
+            msg.child_frame_id.c_str(), msg.linear[0], msg.linear[1], msg.linear[2], msg.angular[0],
+            msg.angular[1], msg.angular[2], t[0], t[1], t[7], t[35], t[5], t[14], t[21]);
+      }
       std::fflush(stdout);
     }
   }
