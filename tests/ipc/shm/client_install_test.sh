@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # Installs the client component into a scratch prefix, builds the example
 # controller from there with pkg-config only, and runs it against a missing
-# segment (it must report "no daemon", exit 3).
+# segment (it must report "no daemon", exit 3); the installed Python module
+# must load the installed library by its soname and say NOT_FOUND too.
 set -euo pipefail
 build_dir=$1
 source_file=$2
@@ -23,4 +24,17 @@ rc=$?
 set -e
 grep -q "ceilpose-install-test" "$prefix/err" || { cat "$prefix/err"; exit 1; }
 test "$rc" -eq 3 || { echo "expected exit 3, got $rc"; exit 1; }
-echo "ok: installed client builds with pkg-config and runs"
+py_dir=$prefix/lib/python3/dist-packages
+test -f "$py_dir/ceilpose/__init__.py" || { echo "ceilpose Python module not installed"; exit 1; }
+env -u CEILPOSE_CLIENT_LIBRARY LD_LIBRARY_PATH=$libdir PYTHONPATH=$py_dir PYTHONDONTWRITEBYTECODE=1 \
+  python3 -c '
+import ceilpose
+try:
+    ceilpose.Client("/ceilpose-install-test-py")
+except ceilpose.CeilposeError as e:
+    assert e.name == "NOT_FOUND", e
+    print("python:", e)
+else:
+    raise SystemExit("expected NOT_FOUND")
+' || { echo "installed Python module does not work"; exit 1; }
+echo "ok: installed client builds with pkg-config and runs; the Python module loads it"

@@ -1,0 +1,117 @@
+"""The `ceilpose` Python module against a real ceilposed (synthetic camera,
+its own segment, DDS off): latest, wait_next, predict and the errors.
+
+Run by ctest with CEILPOSE_CLIENT_LIBRARY (the built C client), PYTHONPATH
+(ipc/python) and CEILPOSED (the daemon) set; python3 from Debian."""
+
+import math
+import os
+import subprocess
+import tempfile
+import time
+import unittest
+
+import ceilpose
+
+
+class ClientAgainstDaemon(unittest.TestCase):
+    @classmethod
+    def setUpClass(cls):
+        cls.shm = f"/ceilpose-pytest-{os.getpid()}"
+        cls.dir = tempfile.TemporaryDirectory()
+        config = os.path.join(cls.dir.name, "ceilpose.yaml")
+        with open(config, "w") as f:
+            f.write("filter:\n  enabled: true\ndds:\n  enabled: false\n")
+        cls.daemon = subprocess.Popen(
+            [os.environ["CEILPOSED"], "--config", config, "--source", "synthetic", "--shm",
+             cls.shm, "--duration", "120"],
+            stdout=subprocess.DEVNULL, stderr=subprocess.PIPE)
+        deadline = time.monotonic() + 30.0
+        cls.client = None
+        while time.monotonic() < deadline and cls.daemon.poll() is None:
+            try:
+                cls.client = ceilpose.Client(cls.shm)
+                cls.client.wait_next(timeout_s=5.0)
+                break
+            except ceilpose.CeilposeError:
+                time.sleep(0.1)
+        if cls.client is None:
+            cls.daemon.kill()
+            raise RuntimeError("ceilposed gave no pose: " + cls.daemon.stderr.read().decode())
+
+    @classmethod
+    def tearDownClass(cls):
+        cls.client.close()
+        cls.daemon.terminate()
+        cls.daemon.wait(10)
+        cls.daemon.stderr.close()
+        try:
+            os.unlink("/dev/shm" + cls.shm)
+            os.unlink("/dev/shm" + cls.shm + "-wake")
+        except FileNotFoundError:
+            pass
+        cls.dir.cleanup()
+
+    def settled_pose(self):
+        pose = None
+        for _ in range(30):  # one second: the filter's velocity settles
+            pose = self.client.wait_next(timeout_s=2.0)
+        return pose
+
+    def test_latest_is_a_valid_filtered_pose_on_the_grid(self):
+        pose = self.client.latest()
+        self.assertTrue(pose.valid)
+        self.assertTrue(pose.filtered)
+        self.assertEqual(pose.mode, "lsq")
+        self.assertGreaterEqual(pose.markers, 3)
+        self.assertTrue(0.0 < pose.x_m < 5.0 and 0.0 < pose.y_m < 5.0, pose)
+        self.assertEqual(pose.refusal, "none")
+        self.assertGreater(pose.covariance[0], 0.0)
+        self.assertLess(pose.age_ms(), 5000.0)
+
+    def test_wait_next_returns_newer_poses_with_the_patrols_speed(self):
+        first = self.client.wait_next(timeout_s=2.0)
+        pose = self.settled_pose()
+        self.assertGreater(pose.seq, first.seq)
+        self.assertGreater(pose.capture_mono_ns, first.capture_mono_ns)
+        self.assertTrue(pose.has_motion)
+        self.assertAlmostEqual(math.hypot(pose.vx_mps, pose.vy_mps), 1.2, delta=0.05)
+        self.assertGreater(pose.velocity_covariance[0], 0.0)
+
+    def test_predict_moves_the_pose_along_its_velocity(self):
+        pose = self.settled_pose()
+        ahead = self.client.predict(pose.capture_mono_ns + 100_000_000)  # 100 ms
+        moved = math.hypot(ahead.x_m - pose.x_m, ahead.y_m - pose.y_m)
+        self.assertAlmostEqual(moved, 0.12, delta=0.01)  # 1.2 m/s
+        self.assertGreater(ahead.covariance[0], pose.covariance[0])
+        self.assertEqual(ahead.capture_mono_ns, pose.capture_mono_ns)
+        now = self.client.predict()  # default: now
+        self.assertTrue(now.valid)
+
+    def test_predict_beyond_the_horizon_raises(self):
+        pose = self.client.latest()
+        with self.assertRaises(ceilpose.CeilposeError) as e:
+            self.client.predict(pose.capture_mono_ns + 5_000_000_000)
+        self.assertEqual(e.exception.name, "HORIZON")
+        self.assertIn("beyond the prediction horizon", str(e.exception))
+
+    def test_wait_next_times_out_when_nothing_newer_can_come(self):
+        with self.assertRaises(ceilpose.CeilposeError) as e:
+            self.client.wait_next(timeout_s=0.05, after_seq=2**63)
+        self.assertEqual(e.exception.name, "TIMEOUT")
+
+
+class ClientWithoutDaemon(unittest.TestCase):
+    def test_a_missing_segment_says_so(self):
+        name = f"/ceilpose-pytest-missing-{os.getpid()}"
+        with self.assertRaises(ceilpose.CeilposeError) as e:
+            ceilpose.Client(name)
+        self.assertEqual(e.exception.name, "NOT_FOUND")
+        self.assertIn(name, str(e.exception))
+
+    def test_the_record_layout_is_abi_3(self):
+        self.assertEqual(ceilpose.ABI_VERSION, 3)
+
+
+if __name__ == "__main__":
+    unittest.main()
