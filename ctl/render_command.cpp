@@ -5,6 +5,7 @@
 #include <cstdio>
 #include <iostream>
 #include <memory>
+#include <optional>
 #include <string>
 
 #include "calibration/board_spec.h"
@@ -32,6 +33,7 @@ struct RenderArgs {
   uint64_t ceiling_seed = 0;  // 0: --seed
   std::string truth_map_file;
   std::string board = "checkerboard:9x6:0.03";
+  std::optional<double> readout_ms;  // --readout-ms: over the configuration's camera.readout_ms
   int frames = 100;
   uint64_t seed = 1;
   bool list = false;
@@ -116,6 +118,7 @@ void run_render(const RenderArgs& args) {
   Result<ServiceConfig> calibrated = with_calibration_files(config);
   if (!report(calibrated ? Result<void>() : calibrated.error(), kExitBadInput)) return;
   config = std::move(calibrated).value();
+  if (args.readout_ms) config.pipeline.intrinsics.readout_ms = *args.readout_ms;
   options.layout = config.pipeline.layout;
   options.intrinsics = config.pipeline.intrinsics;
   const CameraMount mount = config.pipeline.mount;
@@ -129,6 +132,7 @@ void run_render(const RenderArgs& args) {
                 kExitBadInput))
       return;
     options.intrinsics = *truth;
+    options.intrinsics.readout_ms = config.pipeline.intrinsics.readout_ms;
   }
   Result<sim::LaidCeiling> laid = sim::LaidCeiling::parse(
       args.ceiling, options.layout, args.ceiling_seed != 0 ? args.ceiling_seed : args.seed);
@@ -167,7 +171,8 @@ void run_render(const RenderArgs& args) {
     CameraMount frame_mount = mount;
     frame_mount.tilt_x_rad += f.mount.tilt_x_rad;
     frame_mount.tilt_y_rad += f.mount.tilt_y_rad;
-    renderer.render(f.pose, frame_mount, f.effects, f.seed, &frame);
+    sim::render_scenario_frame(renderer, f, frame_mount, options.intrinsics.readout_ms * 1e-3,
+                               &frame);
     // JPEG artefacts are already in the pixels; PNG keeps them exactly.
     Result<void> ok = writer->append(frame.view(), f.timestamp_ns, &f.pose);
     if (!ok) {
@@ -230,6 +235,11 @@ void add_render_command(CLI::App& app) {
       ->capture_default_str();
   cmd->add_option("--truth-map", args->truth_map_file,
                   "Also write the ceiling's true map (SPEC §8) to this file");
+  cmd->add_option("--readout-ms", args->readout_ms,
+                  "Rolling-shutter readout, first row to last, ms (SPEC §3): the moving sets "
+                  "(trajectory, drive) render each row at its own instant, and recording.yaml "
+                  "declares it (default: --config's camera.readout_ms, 0 = global shutter)")
+      ->check(CLI::Range(0.0, 1000.0));
   cmd->add_option("--frames", args->frames, "Number of frames")
       ->capture_default_str()
       ->check(CLI::PositiveNumber);

@@ -71,6 +71,27 @@ bool Renderer::ceiling_point(const Pose2D& robot, const CameraMount& mount, doub
 
 void Renderer::render(const Pose2D& robot, const CameraMount& mount, const Effects& effects,
                       uint64_t frame_seed, Image* out) {
+  const CameraPose pose = camera_pose_from_robot(robot, mount);
+  render_rows([&](int) -> const CameraPose& { return pose; }, true, effects, frame_seed, out);
+}
+
+void Renderer::render_rolling(const PoseAt& pose_at, double readout_s, const CameraMount& mount,
+                              const Effects& effects, uint64_t frame_seed, Image* out) {
+  if (readout_s == 0.0) return render(pose_at(0.0), mount, effects, frame_seed, out);
+  const int h = options_.intrinsics.height;
+  // One camera pose per pixel row (allocated once: the size never changes).
+  row_poses_.resize(static_cast<size_t>(h));
+  for (int r = 0; r < h; ++r) {
+    const double dt_s = (r - 0.5 * (h - 1)) / h * readout_s;
+    row_poses_[static_cast<size_t>(r)] = camera_pose_from_robot(pose_at(dt_s), mount);
+  }
+  render_rows([&](int r) -> const CameraPose& { return row_poses_[static_cast<size_t>(r)]; }, false,
+              effects, frame_seed, out);
+}
+
+template <typename PoseOfRow>
+void Renderer::render_rows(const PoseOfRow& pose_of_row, bool one_map, const Effects& effects,
+                           uint64_t frame_seed, Image* out) {
   // Area integration, adaptively: each pixel corner is classified once (the
   // scene is piecewise constant), a pixel whose four corners agree takes that
   // material's colour, and a pixel that straddles an edge averages an N x N
@@ -80,11 +101,14 @@ void Renderer::render(const Pose2D& robot, const CameraMount& mount, const Effec
   // assumes no feature fits between corners: the thinnest SPEC feature (red
   // dot, rail: 1 in) spans about 3 px even at 320 x 240. Measured centroid
   // error of rendered rectangles: about 0.003 px (tests/sim geometry_test).
+  // With one mapping per row (rolling shutter) a row's corners are
+  // classified through its own mapping, so the corners between two rows are
+  // classified twice.
   const int w = options_.intrinsics.width, h = options_.intrinsics.height, cw = w + 1;
-  const CeilingMap map(camera_pose_from_robot(robot, mount), options_.layout.height_m);
   const bool fixtures = effects.light_fixtures;
   const int clutter = std::clamp(effects.clutter_objects, 0, kMaxClutterObjects);
   const auto& colours = scene_.linear_colours();
+  CeilingMap map(pose_of_row(0), options_.layout.height_m);
   auto material = [&](double x, double y) -> uint8_t {
     double wx = 0.0, wy = 0.0;
     if (!map(x, y, &wx, &wy)) return kMaterialNone;
@@ -98,6 +122,10 @@ void Renderer::render(const Pose2D& robot, const CameraMount& mount, const Effec
   constexpr float inv_count = 1.0f / (n * n);
   classify_row(0, row_above_.data());
   for (int r = 0; r < h; ++r) {
+    if (!one_map) {
+      map = CeilingMap(pose_of_row(r), options_.layout.height_m);
+      if (r > 0) classify_row(r, row_above_.data());
+    }
     classify_row(r + 1, row_below_.data());
     const float* top = corner_xy_.data() + static_cast<size_t>(r) * cw * 2;
     const float* bottom = top + static_cast<size_t>(cw) * 2;

@@ -13,6 +13,7 @@
 //
 // Thread: one Renderer per thread (render() uses internal buffers).
 #include <cstdint>
+#include <functional>
 #include <memory>
 #include <vector>
 
@@ -51,6 +52,14 @@ class Renderer {
   void render(const Pose2D& robot, const CameraMount& mount, const Effects& effects,
               uint64_t frame_seed, Image* out);
 
+  // The same through a rolling shutter (SPEC §3): pixel row v shows the
+  // robot at pose_at(dt) with dt = (v - (height - 1)/2) / height * readout_s
+  // seconds after the frame's time, the whole row at once. readout_s = 0
+  // gives exactly render()'s image (one pose for every row).
+  using PoseAt = std::function<Pose2D(double dt_s)>;
+  void render_rolling(const PoseAt& pose_at, double readout_s, const CameraMount& mount,
+                      const Effects& effects, uint64_t frame_seed, Image* out);
+
   // The ceiling point (x, y) that pixel (u, v) sees, through the same ray
   // mapping render() uses. False when the ray does not reach the ceiling.
   bool ceiling_point(const Pose2D& robot, const CameraMount& mount, double u_px, double v_px,
@@ -60,14 +69,22 @@ class Renderer {
   const CeilingScene& scene() const { return scene_; }
 
  private:
+  // Integrates every pixel row r as seen from camera pose pose_of_row(r)
+  // (`one_map`: the same for every row) into linear_, then applies the
+  // photometry.
+  template <typename PoseOfRow>
+  void render_rows(const PoseOfRow& pose_of_row, bool one_map, const Effects& effects,
+                   uint64_t frame_seed, Image* out);
+
   SceneOptions options_;
   CeilingScene scene_;
   // Undistorted normalized coordinates (x, y) of every pixel corner,
   // (width+1) x (height+1), computed once: the distortion model is inverted
   // here and never per frame.
   std::vector<float> corner_xy_;
-  std::vector<float> linear_;       // integrated radiance, width*height*3
-  std::vector<uint8_t> row_above_;  // materials at the corners above the current pixel row
+  std::vector<float> linear_;          // integrated radiance, width*height*3
+  std::vector<CameraPose> row_poses_;  // render_rolling: the camera at each row's time
+  std::vector<uint8_t> row_above_;     // materials at the corners above the current pixel row
   std::vector<uint8_t> row_below_;
   Photometry photometry_;
 };

@@ -73,18 +73,19 @@ Result<ScenarioFrame> thesis_points(Context& c) {
   return f;
 }
 
-Result<ScenarioFrame> trajectory(Context& c) {
-  ScenarioFrame f =
-      at(trajectory_pose(c.options.layout, c.index * (kScenarioFramePeriod_ns * 1e-9)));
+// A frame on a scripted path, at the frame's time.
+ScenarioFrame on_path(Context& c, Pose2D (*path)(const CeilingLayout&, double)) {
+  const double t_s = c.index * (kScenarioFramePeriod_ns * 1e-9);
+  ScenarioFrame f = at(path(c.options.layout, t_s));
+  f.path = path;
+  f.path_t_s = t_s;
   f.effects.read_noise_sigma = 2.0;
   return f;
 }
 
-Result<ScenarioFrame> drive(Context& c) {
-  ScenarioFrame f = at(drive_pose(c.options.layout, c.index * (kScenarioFramePeriod_ns * 1e-9)));
-  f.effects.read_noise_sigma = 2.0;
-  return f;
-}
+Result<ScenarioFrame> trajectory(Context& c) { return on_path(c, &trajectory_pose); }
+
+Result<ScenarioFrame> drive(Context& c) { return on_path(c, &drive_pose); }
 
 // Most sets are uniform random poses over the grid with one kind of effect;
 // they differ only in how they set the effects.
