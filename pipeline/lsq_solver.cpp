@@ -6,8 +6,26 @@
 namespace ceilpose {
 namespace {
 
-constexpr int kN = 6;
-enum Param : int { kTx = 0, kTy = 1, kYaw = 2, kTiltX = 3, kTiltY = 4, kTz = 5 };
+constexpr int kN = 9;
+enum Param : int {
+  kTx = 0,
+  kTy = 1,
+  kYaw = 2,
+  kTiltX = 3,
+  kTiltY = 4,
+  kTz = 5,
+  kVx = 6,
+  kVy = 7,
+  kYawRate = 8
+};
+// The motion is estimated only from markers spread over at least this share
+// of the readout's rows, and at least this many of them; otherwise it is held
+// (at rest). Its prior (1 m/s, 3 rad/s per pixel of residual) only conditions
+// the solve when the rows barely tell it.
+constexpr double kMotionMinRowSpan = 0.3;
+constexpr int kMotionMinMarkers = 3;
+constexpr double kMotionPriorMps = 1.0;
+constexpr double kMotionPriorRadps = 3.0;
 // Marker-level rejection passes after the first solve.
 constexpr int kMaxRejections = 3;
 
@@ -105,18 +123,71 @@ void point_jacobian(double fx, double fy, const Mat3& rt, const std::array<Vec3,
     const Vec3 col = mat_vec(rt, cross);
     for (int row = 0; row < 3; ++row) dp[row][rot_cols[c]] = col[row];
   }
-  for (int c = 0; c < kN; ++c) {
+  for (int c = 0; c < kVx; ++c) {
     // ∂r/∂param = −f·∂(projection)/∂param
     jx[c] = -fx * iz * (dp[0][c] - p[0] * iz * dp[2][c]);
     jy[c] = -fy * iz * (dp[1][c] - p[1] * iz * dp[2][c]);
   }
 }
 
+// The motion's columns for a point exposed tau seconds after the centre row:
+// its camera is t + v·tau and Exp(w·tau·z)·R, so moving v or w moves it as
+// moving t or the yaw by tau times as much.
+void motion_jacobian(double tau_s, double* jx, double* jy) {
+  jx[kVx] = tau_s * jx[kTx];
+  jx[kVy] = tau_s * jx[kTy];
+  jx[kYawRate] = tau_s * jx[kYaw];
+  jy[kVx] = tau_s * jy[kTx];
+  jy[kVy] = tau_s * jy[kTy];
+  jy[kYawRate] = tau_s * jy[kYaw];
+}
+
+// Rotation by angle a about the world's vertical, applied on the left.
+Mat3 turned(const Mat3& r, double a) {
+  const double s = std::sin(a), c = std::cos(a);
+  return mat_mul({c, -s, 0.0, s, c, 0.0, 0.0, 0.0, 1.0}, r);
+}
+
 }  // namespace
 
-double LsqSolver::residual2_px(const ViewGeometry& view, const Mat3& r_cw, const Vec3& t_w,
-                               const Point& pt) {
-  const Vec3 p = mat_vec(r_cw, {pt.world[0] - t_w[0], pt.world[1] - t_w[1], pt.world[2] - t_w[2]});
+void LsqSolver::camera_at(const State& st, const Point& pt, Vec3* t_w, Mat3* r_wc) {
+  if (pt.tau_s == 0.0) {  // global shutter: no arithmetic, the same bits
+    *t_w = st.t_w;
+    *r_wc = st.r_wc;
+    return;
+  }
+  *t_w = {st.t_w[0] + st.vx * pt.tau_s, st.t_w[1] + st.vy * pt.tau_s, st.t_w[2]};
+  *r_wc = turned(st.r_wc, st.w * pt.tau_s);
+}
+
+LsqSolver::PointCamera LsqSolver::point_camera(const State& st, const Point& pt,
+                                               const PointCamera& centre, bool with_axes) {
+  PointCamera cam = centre;
+  Vec3 t_w = st.t_w;
+  if (pt.tau_s != 0.0) {
+    Mat3 r_wc;
+    camera_at(st, pt, &t_w, &r_wc);
+    cam.rt = mat_transpose(r_wc);
+    if (with_axes) {
+      // The turn about the vertical turns the level axes with it; the yaw
+      // axis stays vertical.
+      const double a = st.w * pt.tau_s, sa = std::sin(a), ca = std::cos(a);
+      for (int k = 1; k < 3; ++k) {
+        const Vec3 l = centre.axis[k];
+        cam.axis[k] = {ca * l[0] - sa * l[1], sa * l[0] + ca * l[1], l[2]};
+      }
+    }
+  }
+  cam.d = {pt.world[0] - t_w[0], pt.world[1] - t_w[1], pt.world[2] - t_w[2]};
+  return cam;
+}
+
+double LsqSolver::residual2_px(const ViewGeometry& view, const State& st, const Point& pt) {
+  Vec3 t_w;
+  Mat3 r_wc;
+  camera_at(st, pt, &t_w, &r_wc);
+  const Vec3 p = mat_vec(mat_transpose(r_wc),
+                         {pt.world[0] - t_w[0], pt.world[1] - t_w[1], pt.world[2] - t_w[2]});
   const double rx = view.intrinsics().fx * (pt.x_n - p[0] / p[2]);
   const double ry = view.intrinsics().fy * (pt.y_n - p[1] / p[2]);
   return rx * rx + ry * ry;
@@ -137,8 +208,7 @@ double LsqSolver::accumulate(const ViewGeometry& view, const PositioningParams& 
                              Normal* a, Vector* b, double* sum_w_r2, int* count) const {
   const double fx = view.intrinsics().fx, fy = view.intrinsics().fy;
   const double k = params.lsq_huber_px;
-  const Mat3 rt = mat_transpose(st.r_wc);
-  const std::array<Vec3, 3> axis = increment_axes(st.r_wc);
+  const PointCamera centre{{}, mat_transpose(st.r_wc), increment_axes(st.r_wc)};
   if (with_jacobian) {
     a->fill(0.0);
     b->fill(0.0);
@@ -148,8 +218,9 @@ double LsqSolver::accumulate(const ViewGeometry& view, const PositioningParams& 
   for (int i = 0; i < point_count_; ++i) {
     const Point& pt = points_[i];
     if (!use[pt.fix]) continue;
-    const Vec3 d{pt.world[0] - st.t_w[0], pt.world[1] - st.t_w[1], pt.world[2] - st.t_w[2]};
-    const Vec3 p = mat_vec(rt, d);
+    const PointCamera cam = point_camera(st, pt, centre, with_jacobian);
+    const Vec3& d = cam.d;
+    const Vec3 p = mat_vec(cam.rt, d);
     if (p[2] < 1e-3) return INFINITY;  // a point behind the camera: diverged
     const double iz = 1.0 / p[2];
     const double rx = fx * (pt.x_n - p[0] * iz), ry = fy * (pt.y_n - p[1] * iz);
@@ -160,7 +231,8 @@ double LsqSolver::accumulate(const ViewGeometry& view, const PositioningParams& 
     ++n;
     if (!with_jacobian) continue;
     double jx[kN], jy[kN];
-    point_jacobian(fx, fy, rt, axis, d, p, jx, jy);
+    point_jacobian(fx, fy, cam.rt, cam.axis, d, p, jx, jy);
+    motion_jacobian(pt.tau_s, jx, jy);
     for (int r1 = 0; r1 < kN; ++r1) {
       (*b)[r1] -= w * (jx[r1] * rx + jy[r1] * ry);
       for (int c = r1; c < kN; ++c) (*a)[r1 * kN + c] += w * (jx[r1] * jx[c] + jy[r1] * jy[c]);
@@ -180,7 +252,19 @@ double LsqSolver::accumulate(const ViewGeometry& view, const PositioningParams& 
 // is that of one 1-pixel residual per lsq_tilt_prior_rad.
 double LsqSolver::prior_cost(const ViewGeometry& view, const PositioningParams& params,
                              const State& st, Normal* a, Vector* b) const {
-  if (!active_[kTiltX]) return 0.0;
+  double motion = 0.0;
+  if (active_[kVx]) {
+    const double wv = 1.0 / kMotionPriorMps, ww = 1.0 / kMotionPriorRadps;
+    const double r[3] = {wv * st.vx, wv * st.vy, ww * st.w};
+    const double wt[3] = {wv, wv, ww};
+    for (int k = 0; k < 3; ++k) {
+      motion += r[k] * r[k];
+      if (a == nullptr) continue;
+      (*a)[(kVx + k) * kN + kVx + k] += wt[k] * wt[k];
+      (*b)[kVx + k] -= wt[k] * r[k];
+    }
+  }
+  if (!active_[kTiltX]) return motion;
   double ta = 0.0, tb = 0.0;
   camera_tilt(st.r_wc, &ta, &tb);
   const double w = 1.0 / params.lsq_tilt_prior_rad;
@@ -191,7 +275,20 @@ double LsqSolver::prior_cost(const ViewGeometry& view, const PositioningParams& 
     (*b)[kTiltX] -= w * ra;
     (*b)[kTiltY] -= w * rb;
   }
-  return ra * ra + rb * rb;
+  return motion + ra * ra + rb * rb;
+}
+
+bool LsqSolver::motion_observable(const ViewGeometry& view, std::span<const bool> use,
+                                  int marker_count) const {
+  const double readout_s = view.intrinsics().readout_ms * 1e-3;
+  if (!(readout_s > 0.0) || marker_count < kMotionMinMarkers) return false;
+  double lo = INFINITY, hi = -INFINITY;
+  for (int i = 0; i < point_count_; ++i) {
+    if (!use[points_[i].fix]) continue;
+    lo = std::min(lo, points_[i].tau_s);
+    hi = std::max(hi, points_[i].tau_s);
+  }
+  return hi - lo >= kMotionMinRowSpan * readout_s;
 }
 
 // Levenberg–Marquardt with Huber weights (IRLS) over the active
@@ -224,6 +321,9 @@ double LsqSolver::optimise(const ViewGeometry& view, const PositioningParams& pa
       Vec3 w{0.0, 0.0, step[kYaw]};
       for (int r = 0; r < 3; ++r) w[r] += step[kTiltX] * lev[r * 3] + step[kTiltY] * lev[r * 3 + 1];
       trial.r_wc = mat_mul(exp_so3(w), st.r_wc);
+      trial.vx += step[kVx];
+      trial.vy += step[kVy];
+      trial.w += step[kYawRate];
       Normal ta{};
       Vector tb{};
       double twr2 = 0.0;
@@ -248,7 +348,6 @@ double LsqSolver::optimise(const ViewGeometry& view, const PositioningParams& pa
     // Per-marker RMS residual; the worst offender is dropped if too large.
     int worst = -1;
     double worst_rms2 = params.lsq_marker_reject_px * params.lsq_marker_reject_px;
-    const Mat3 rt = mat_transpose(st.r_wc);
     for (int f = 0; f < static_cast<int>(fixes.size()); ++f) {
       if (!use[f]) continue;
       double sum = 0.0;
@@ -256,7 +355,7 @@ double LsqSolver::optimise(const ViewGeometry& view, const PositioningParams& pa
       for (int i = 0; i < point_count_; ++i) {
         const Point& pt = points_[i];
         if (pt.fix != f) continue;
-        sum += residual2_px(view, rt, st.t_w, pt);
+        sum += residual2_px(view, st, pt);
         ++cnt;
       }
       if (cnt > 0 && sum / cnt > worst_rms2) {
@@ -268,6 +367,10 @@ double LsqSolver::optimise(const ViewGeometry& view, const PositioningParams& pa
     use[worst] = false;
     --*marker_count;
     if (*marker_count < params.lsq_tilt_min_markers) active_[kTiltX] = active_[kTiltY] = false;
+    if (active_[kVx] && !motion_observable(view, use, *marker_count)) {
+      active_[kVx] = active_[kVy] = active_[kYawRate] = false;
+      st.vx = st.vy = st.w = 0.0;
+    }
   }
   return cost;
 }
@@ -280,6 +383,10 @@ int LsqSolver::gather_points(const ViewGeometry& view, std::span<const MarkerObs
                              std::span<const MarkerFix> fixes, std::span<const bool> use,
                              State* seed) {
   const CeilingLayout& layout = view.layout();
+  const CameraIntrinsics& k = view.intrinsics();
+  // SPEC §3: row v is exposed (v - (height - 1)/2) / height * readout after
+  // the centre row.
+  const double row_s = k.readout_ms * 1e-3 / k.height;
   point_count_ = 0;
   int marker_count = 0;
   double sin_sum = 0.0, cos_sum = 0.0, x_sum = 0.0, y_sum = 0.0;
@@ -295,6 +402,7 @@ int LsqSolver::gather_points(const ViewGeometry& view, std::span<const MarkerObs
       }
       Point& p = points_[point_count_++];
       undistort_pixel(view.intrinsics(), u_px, v_px, &p.x_n, &p.y_n);
+      p.tau_s = (v_px - 0.5 * (k.height - 1)) * row_s;
       double x_m = 0.0, y_m = 0.0;
       fix.placement->world_point(e_m, n_m, &x_m, &y_m);
       p.world = {x_m, y_m, layout.height_m};
@@ -334,7 +442,8 @@ int LsqSolver::gather_points(const ViewGeometry& view, std::span<const MarkerObs
 double LsqSolver::fit(const ViewGeometry& view, const PositioningParams& params,
                       std::span<const MarkerFix> fixes, std::span<bool> use, State* st,
                       int* marker_count, int* iterations, bool* tilt_estimated) {
-  active_ = {true, true, true, false, false, params.lsq_estimate_height};
+  const bool motion = motion_observable(view, use, *marker_count);
+  active_ = {true, true, true, false, false, params.lsq_estimate_height, motion, motion, motion};
   *tilt_estimated = false;
   const bool tilt_allowed =
       params.lsq_estimate_tilt && *marker_count >= params.lsq_tilt_min_markers;
@@ -379,11 +488,10 @@ double LsqSolver::fit(const ViewGeometry& view, const PositioningParams& params,
 double LsqSolver::rms_px(const ViewGeometry& view, std::span<const bool> use, const State& st,
                          int n) const {
   double sum_r2 = 0.0;
-  const Mat3 rt = mat_transpose(st.r_wc);
   for (int i = 0; i < point_count_; ++i) {
     const Point& pt = points_[i];
     if (!use[pt.fix]) continue;
-    sum_r2 += residual2_px(view, rt, st.t_w, pt);
+    sum_r2 += residual2_px(view, st, pt);
   }
   return std::sqrt(sum_r2 / n);
 }
@@ -406,15 +514,15 @@ LsqSolver::Normal LsqSolver::placement_information(const ViewGeometry& view,
                                                    std::span<const bool> use, const State& st) {
   const double fx = view.intrinsics().fx, fy = view.intrinsics().fy;
   const double k = params.lsq_huber_px;
-  const Mat3 rt = mat_transpose(st.r_wc);
-  const std::array<Vec3, 3> axis = increment_axes(st.r_wc);
+  const PointCamera centre{{}, mat_transpose(st.r_wc), increment_axes(st.r_wc)};
   const int n_fix = static_cast<int>(fixes.size());
   for (int f = 0; f < n_fix; ++f) marker_terms_[f] = MarkerTerm{};
   for (int i = 0; i < point_count_; ++i) {
     const Point& pt = points_[i];
     if (!consistent[pt.fix]) continue;
-    const Vec3 d{pt.world[0] - st.t_w[0], pt.world[1] - st.t_w[1], pt.world[2] - st.t_w[2]};
-    const Vec3 p = mat_vec(rt, d);
+    const PointCamera cam = point_camera(st, pt, centre, true);
+    const Vec3& d = cam.d;
+    const Vec3 p = mat_vec(cam.rt, d);
     if (p[2] < 1e-3) continue;
     const double iz = 1.0 / p[2];
     const double rx = fx * (pt.x_n - p[0] * iz), ry = fy * (pt.y_n - p[1] * iz);
@@ -423,7 +531,8 @@ LsqSolver::Normal LsqSolver::placement_information(const ViewGeometry& view,
     // evidence of how far off their places the markers are.
     const double w = !use[pt.fix] ? 0.0 : r <= k ? 1.0 : k / r;
     double jx[kN], jy[kN];
-    point_jacobian(fx, fy, rt, axis, d, p, jx, jy);
+    point_jacobian(fx, fy, cam.rt, cam.axis, d, p, jx, jy);
+    motion_jacobian(pt.tau_s, jx, jy);
     // A marker shift moves its points as a camera shift the other way; its
     // rotation moves a point at (dx, dy) from the centre by (−dy, dx)·dθ.
     const MarkerFix& fix = fixes[pt.fix];
@@ -453,7 +562,7 @@ LsqSolver::Normal LsqSolver::placement_information(const ViewGeometry& view,
       b[r1] = term.jtr[r1];
       for (int c = 0; c < 3; ++c) a[r1 * kN + c] = term.jtj[r1 * 3 + c];
     }
-    const std::array<bool, kN> three{true, true, true, false, false, false};
+    const std::array<bool, kN> three{true, true, true, false, false, false, false, false, false};
     if (!solve_spd(a, three, b, &x)) continue;
     ++markers;
     shift_m2 += x[0] * x[0] + x[1] * x[1];
@@ -561,6 +670,10 @@ bool LsqSolver::solve(const ViewGeometry& view, const PositioningParams& params,
   camera_tilt(st.r_wc, &out->tilt_x_rad, &out->tilt_y_rad);
   out->lens_height_m = st.t_w[2];
   out->tilt_estimated = tilt_estimated;
+  out->motion_estimated = active_[kVx];
+  out->cam_vx_mps = st.vx;
+  out->cam_vy_mps = st.vy;
+  out->yaw_rate_radps = st.w;
   return true;
 }
 

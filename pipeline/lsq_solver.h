@@ -26,6 +26,13 @@ struct LsqResult {
   double tilt_y_rad = 0.0;
   double lens_height_m = 0.0;
   bool tilt_estimated = false;  // false: held at the mount's nominal tilt
+  // Rolling shutter (camera.readout_ms > 0): the optical centre's velocity
+  // and the yaw rate during the readout, world frame, when the markers span
+  // enough rows to tell them (motion_estimated); the pose is the centre row's.
+  double cam_vx_mps = 0.0;
+  double cam_vy_mps = 0.0;
+  double yaw_rate_radps = 0.0;
+  bool motion_estimated = false;
 };
 
 // Holds the per-frame work arrays (sized for the largest frame), so solve()
@@ -47,12 +54,28 @@ class LsqSolver {
     double x_n, y_n;  // undistorted normalized observation (camera frame)
     Vec3 world;       // marker point on the ceiling
     int fix;          // index into fixes
+    double tau_s;     // when its row was exposed, after the centre row (rolling shutter)
   };
   struct State {
-    Vec3 t_w;   // optical centre
-    Mat3 r_wc;  // camera axes in the world
+    Vec3 t_w;                            // optical centre at the centre row's time
+    Mat3 r_wc;                           // camera axes in the world, then
+    double vx = 0.0, vy = 0.0, w = 0.0;  // optical centre velocity, yaw rate
   };
-  static constexpr int kParams = 6;  // tx, ty, yaw, tilt about Xc, tilt about Yc, tz
+  // tx, ty, yaw, tilt about Xc, tilt about Yc, tz, and the motion during the
+  // readout: vx, vy, yaw rate.
+  static constexpr int kParams = 9;
+  // The camera when point pt's row was exposed.
+  static void camera_at(const State& st, const Point& pt, Vec3* t_w, Mat3* r_wc);
+  // What a point's residual and Jacobian need of that camera: Rᵀ, the
+  // increment axes (with_axes) and d = P − t. `centre` holds Rᵀ and the axes
+  // at the centre row, which a global shutter's points reuse.
+  struct PointCamera {
+    Vec3 d;
+    Mat3 rt;
+    std::array<Vec3, 3> axis;
+  };
+  static PointCamera point_camera(const State& st, const Point& pt, const PointCamera& centre,
+                                  bool with_axes);
   using Normal = std::array<double, kParams * kParams>;
   using Vector = std::array<double, kParams>;
 
@@ -61,13 +84,15 @@ class LsqSolver {
                     std::span<const bool> use, const State& state, bool with_jacobian, Normal* a,
                     Vector* b, double* sum_w_r2, int* count) const;
   // Squared reprojection residual of one point, pixels².
-  static double residual2_px(const ViewGeometry& view, const Mat3& r_cw, const Vec3& t_w,
-                             const Point& pt);
+  static double residual2_px(const ViewGeometry& view, const State& st, const Point& pt);
   double optimise(const ViewGeometry& view, const PositioningParams& params, std::span<bool> use,
                   std::span<const MarkerFix> fixes, bool reject, State* state, int* marker_count,
                   int* iterations);
   double prior_cost(const ViewGeometry& view, const PositioningParams& params, const State& state,
                     Normal* a, Vector* b) const;
+  // Whether the points span enough rows (and markers) to estimate the motion.
+  bool motion_observable(const ViewGeometry& view, std::span<const bool> use,
+                         int marker_count) const;
   // The steps of solve(), in order (see lsq_solver.cpp).
   int gather_points(const ViewGeometry& view, std::span<const MarkerObservation> markers,
                     std::span<const MarkerFix> fixes, std::span<const bool> use, State* seed);

@@ -98,28 +98,35 @@ Pose2D drive_pose(const CeilingLayout& layout, double t_s) {
   const double span_m = (layout.codes() - 1) * layout.grid_m;
   // Sized for the default 8 x 8 grid (span 4.27 m); smaller grids shrink it.
   const DrivePath path{0.5 * span_m, 0.5 * span_m, std::min(1.0, span_m / 4.267)};
-  // Arc length along u, tabulated once per call (never on a hot path): the
-  // speed profile is given in metres per second, not in u per second.
-  std::vector<double> arc_m(kDriveSamples + 1, 0.0);
-  double px = 0.0, py = 0.0;
-  path.at(0.0, &px, &py);
-  for (int k = 1; k <= kDriveSamples; ++k) {
-    double x = 0.0, y = 0.0;
-    path.at(2.0 * kPi * k / kDriveSamples, &x, &y);
-    arc_m[k] = arc_m[k - 1] + std::hypot(x - px, y - py);
-    px = x;
-    py = y;
-  }
+  // Arc length along u of the unit-scale path, tabulated once per process
+  // (a rolling-shutter frame asks for a pose per row): the speed profile is
+  // given in metres per second, not in u per second.
+  static const std::vector<double> unit_arc = [] {
+    const DrivePath unit{0.0, 0.0, 1.0};
+    std::vector<double> arc(kDriveSamples + 1, 0.0);
+    double px = 0.0, py = 0.0;
+    unit.at(0.0, &px, &py);
+    for (int k = 1; k <= kDriveSamples; ++k) {
+      double x = 0.0, y = 0.0;
+      unit.at(2.0 * kPi * k / kDriveSamples, &x, &y);
+      arc[k] = arc[k - 1] + std::hypot(x - px, y - py);
+      px = x;
+      py = y;
+    }
+    return arc;
+  }();
+  const double total_m = path.scale * unit_arc.back();
   // Speed between kDriveMinSpeed_mps and kDriveMaxSpeed_mps, one period
   // every kDriveSpeedPeriod_s: s(t) = ∫ v.
   const double mean = 0.5 * (kDriveMinSpeed_mps + kDriveMaxSpeed_mps);
   const double amp = 0.5 * (kDriveMaxSpeed_mps - kDriveMinSpeed_mps);
   const double w = 2.0 * kPi / kDriveSpeedPeriod_s;
-  double s_m = std::fmod(mean * t_s - amp / w * std::sin(w * t_s), arc_m.back());
-  if (s_m < 0.0) s_m += arc_m.back();
-  const auto it = std::upper_bound(arc_m.begin(), arc_m.end(), s_m);
-  const int k = std::clamp(static_cast<int>(it - arc_m.begin()) - 1, 0, kDriveSamples - 1);
-  const double f = (s_m - arc_m[k]) / std::max(1e-12, arc_m[k + 1] - arc_m[k]);
+  double s_m = std::fmod(mean * t_s - amp / w * std::sin(w * t_s), total_m);
+  if (s_m < 0.0) s_m += total_m;
+  const double s_unit = s_m / path.scale;
+  const auto it = std::upper_bound(unit_arc.begin(), unit_arc.end(), s_unit);
+  const int k = std::clamp(static_cast<int>(it - unit_arc.begin()) - 1, 0, kDriveSamples - 1);
+  const double f = (s_unit - unit_arc[k]) / std::max(1e-12, unit_arc[k + 1] - unit_arc[k]);
   const double u = 2.0 * kPi * (k + f) / kDriveSamples;
   double x = 0.0, y = 0.0, xa = 0.0, ya = 0.0, xb = 0.0, yb = 0.0;
   path.at(u, &x, &y);

@@ -33,7 +33,7 @@ int accuracy_frames(int release_frames) {
 
 AccuracyReport run_scenario(const std::string& name, int frames, uint64_t seed,
                             PositioningMode mode, bool filter, const PipelineConfig& config,
-                            PoseSink* also) {
+                            PoseSink* also, double rendered_readout_ms) {
   sim::SceneOptions options{config.layout, config.intrinsics, seed, nullptr};
   auto scenario = sim::make_scenario(name, options, frames, seed);
   if (!scenario.ok()) {
@@ -50,7 +50,7 @@ AccuracyReport run_scenario(const std::string& name, int frames, uint64_t seed,
   Localizer localizer(config, LocalizerOptions{mode, filter});
   Image image;
   for (const sim::ScenarioFrame& f : scenario->frames) {
-    renderer.render(f.pose, f.mount, f.effects, f.seed, &image);
+    sim::render_scenario_frame(renderer, f, f.mount, rendered_readout_ms * 1e-3, &image);
     current = &f;
     FrameInfo info;
     info.timestamp_ns = f.timestamp_ns;

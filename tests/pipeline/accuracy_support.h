@@ -17,11 +17,13 @@ int accuracy_frames(int release_frames);
 
 // Renders `frames` frames of scenario `name` (sim/scenarios.h) with `seed`
 // and localizes them with `config` in `mode`, through the daemon's temporal
-// filter when `filter`; `also` (if given) sees every frame too. Fails the calling test (and returns
-// an empty report) if the scenario cannot be made.
+// filter when `filter`; `also` (if given) sees every frame too. The frames
+// are rendered through a rolling shutter of rendered_readout_ms (the moving
+// sets; config.intrinsics.readout_ms is what the localizer is told). Fails the calling test (and
+// returns an empty report) if the scenario cannot be made.
 AccuracyReport run_scenario(const std::string& name, int frames, uint64_t seed,
                             PositioningMode mode, bool filter = false,
                             const PipelineConfig& config = PipelineConfig{},
-                            PoseSink* also = nullptr);
+                            PoseSink* also = nullptr, double rendered_readout_ms = 0.0);
 
 }  // namespace ceilpose::testing
