@@ -27,6 +27,7 @@ struct RecordArgs {
   int width = 640;
   int height = 480;
   double fps = 30.0;
+  double readout_ms = 0.0;  // a live camera's rolling-shutter readout (SPEC §3)
   int jpeg_quality = 0;
   uint64_t seed = 1;
   bool realtime_replay = false;
@@ -58,6 +59,7 @@ std::unique_ptr<capture::FrameSource> start_source(const RecordArgs& a, bool rep
   options.width = a.width;
   options.height = a.height;
   options.fps = a.fps;
+  options.readout_ms = a.readout_ms;
   if (!a.realtime_replay) options.replay_speed = 0.0;  // as fast as possible
   std::shared_ptr<FrameGenerator> generator;
   if (capture::is_synthetic_spec(a.source)) {
@@ -96,6 +98,7 @@ class FrameRecorder {
         camera.source = source_.describe();
       } else {
         camera.intrinsics = scaled_default(frame.image.width, frame.image.height);
+        camera.intrinsics.readout_ms = a_.readout_ms;
         camera.source = source_.describe() + "; uncalibrated: SPEC default intrinsics scaled";
       }
       auto w = RecordingWriter::create(a_.out_dir, camera);
@@ -212,6 +215,11 @@ void add_record_command(CLI::App& app) {
       ->check(CLI::PositiveNumber);
   cmd->add_option("--fps", args->fps, "Frame rate of a camera or the synthetic source (default 30)")
       ->check(CLI::PositiveNumber);
+  cmd->add_option("--readout-ms", args->readout_ms,
+                  "A live camera's rolling-shutter readout, first row to last, ms (SPEC §3): "
+                  "frames are stamped at the centre row and recording.yaml declares it "
+                  "(default 0, a global shutter)")
+      ->check(CLI::Range(0.0, 1000.0));
   cmd->add_option("--jpeg-quality", args->jpeg_quality,
                   "Write JPEG frames at this quality (1..100) instead of PNG")
       ->check(CLI::Range(1, 100));
