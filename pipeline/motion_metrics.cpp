@@ -22,6 +22,7 @@ void MotionAccuracySink::consume(const Localization& loc) {
   if (!loc.frame.has_ground_truth) return;
   truth_.push_back({loc.frame.timestamp_ns, loc.frame.ground_truth});
   if (!loc.published.valid || !loc.motion.valid) return;
+  if (static_cast<int>(truth_.size()) <= settle_frames_) return;
   const MotionState& s = loc.motion.state;
   const int64_t ahead_ns = loc.frame.timestamp_ns + std::llround(predict_ms_ * 1e6);
   const MotionState ahead = motion_at(loc.motion, ahead_ns);

@@ -36,7 +36,10 @@ struct MotionReport {
 
 class MotionAccuracySink final : public PoseSink {
  public:
-  explicit MotionAccuracySink(double predict_ms) : predict_ms_(predict_ms) {}
+  // The first settle_frames frames with ground truth are not scored (the
+  // filter starts at rest: its first predictions are off by v·predict_ms).
+  explicit MotionAccuracySink(double predict_ms, int settle_frames = 0)
+      : predict_ms_(predict_ms), settle_frames_(settle_frames) {}
   void consume(const Localization& loc) override;
   MotionReport report() const;
 
@@ -52,6 +55,7 @@ class MotionAccuracySink final : public PoseSink {
     Pose2D predicted;
   };
   double predict_ms_;
+  int settle_frames_;
   std::vector<Truth> truth_;
   std::vector<Sample> samples_;
 };
