@@ -38,11 +38,10 @@ Mat3 tilt_rotation(double tilt_x_rad, double tilt_y_rad) {
 }
 
 CameraPose camera_pose_from_robot(const Pose2D& robot, const CameraMount& mount) {
-  const double c = std::cos(robot.yaw_rad), s = std::sin(robot.yaw_rad);
+  double ox_m = 0.0, oy_m = 0.0;
+  mount_offset_world(mount, robot.yaw_rad, &ox_m, &oy_m);
   CameraPose pose;
-  pose.t_w = {robot.x_m + mount.offset_forward_m * c - mount.offset_left_m * s,
-              robot.y_m + mount.offset_forward_m * s + mount.offset_left_m * c,
-              mount.lens_height_m};
+  pose.t_w = {robot.x_m + ox_m, robot.y_m + oy_m, mount.lens_height_m};
   const double cam_yaw = robot.yaw_rad + mount.yaw_rad;
   const double cy = std::cos(cam_yaw), sy = std::sin(cam_yaw);
   // Columns Xc, Yc, Zc of the level camera (SPEC §3).

@@ -2,6 +2,7 @@
 // The camera model of SPEC §3: OpenCV pinhole + plumb_bob distortion, the
 // camera mounted on the robot looking up, row 0 towards the robot's forward.
 #include <array>
+#include <cmath>
 
 #include "core/pose.h"
 
@@ -26,6 +27,12 @@ struct CameraIntrinsics {
   bool operator==(const CameraIntrinsics&) const = default;
 };
 
+// SPEC §3: when pixel row v_px (fractional) was exposed, seconds after the
+// centre row; 0 for a global shutter.
+inline double row_time_s(const CameraIntrinsics& k, double v_px) {
+  return (v_px - 0.5 * (k.height - 1)) / k.height * (k.readout_ms * 1e-3);
+}
+
 // Where the camera sits on the robot. SPEC defaults: lens 0.3048 m above the
 // floor, at the robot origin, no mounting yaw, no tilt.
 struct CameraMount {
@@ -36,6 +43,14 @@ struct CameraMount {
   double tilt_x_rad = 0.0;  // rotation about the camera's Xc axis (image right)
   double tilt_y_rad = 0.0;  // rotation about the camera's Yc axis (image down)
 };
+
+// Where the lens sits relative to the robot's origin, world frame, for a
+// robot heading yaw_rad: the mount offset turned by the heading.
+inline void mount_offset_world(const CameraMount& mount, double yaw_rad, double* x_m, double* y_m) {
+  const double c = std::cos(yaw_rad), s = std::sin(yaw_rad);
+  *x_m = mount.offset_forward_m * c - mount.offset_left_m * s;
+  *y_m = mount.offset_forward_m * s + mount.offset_left_m * c;
+}
 
 // Rigid camera pose in the world: p_world = R_wc * p_cam + t_w.
 struct CameraPose {

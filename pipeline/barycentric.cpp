@@ -23,7 +23,8 @@ constexpr int kMaxCandidates = 16;
 // The triangle chosen is the largest one containing q (interpolation); if
 // none contains it, the largest (the least amplified extrapolation).
 bool solve_barycentric(const ViewGeometry& view, const PositioningParams& params,
-                       std::span<const MarkerFix> fixes, std::span<const bool> use, Pose2D* robot) {
+                       std::span<const MarkerFix> fixes, std::span<const bool> use, Pose2D* robot,
+                       std::array<int, 3>* chosen) {
   std::array<int, kMaxCandidates> cand{};
   int n = 0;
   for (int k = 0; k < static_cast<int>(fixes.size()) && n < kMaxCandidates; ++k) {
@@ -74,6 +75,7 @@ bool solve_barycentric(const ViewGeometry& view, const PositioningParams& params
     cos_sum += std::cos(f.cam_yaw_rad);
   }
   *robot = view.robot_from_camera(x, y, std::atan2(sin_sum, cos_sum));
+  *chosen = {best[0], best[1], best[2]};
   return true;
 }
 

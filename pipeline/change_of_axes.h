@@ -6,6 +6,7 @@
 #include "core/ceiling_layout.h"
 #include "core/ceiling_map.h"
 #include "core/pose.h"
+#include "pipeline/camera_motion.h"
 #include "pipeline/marker_observation.h"
 
 namespace ceilpose {
@@ -63,8 +64,11 @@ struct MarkerFix {
 
 // Change of Axes on one marker. False when the marker's code is outside the
 // layout or not on the map, or its red and green centres coincide (no
-// heading).
+// heading). With a rolling shutter and `motion` valid, the answer is the
+// camera at the centre row's instant: each of the marker's points is moved
+// back by the camera's motion since its own row, so that every mode and the
+// consistency checks compare answers of one instant.
 bool marker_fix(const ViewGeometry& view, const MarkerObservation& marker, int index,
-                MarkerFix* fix);
+                const CameraMotion& motion, MarkerFix* fix);
 
 }  // namespace ceilpose

@@ -1,5 +1,8 @@
 #include "pipeline/localizer.h"
 
+#include <algorithm>
+#include <cmath>
+
 #include "core/clock.h"
 
 namespace ceilpose {
@@ -23,7 +26,7 @@ void Localizer::reconfigure(const PipelineConfig& config, LocalizerOptions optio
 const Localization& Localizer::localize(const ImageView& image, const FrameInfo& frame) {
   const int64_t start_ns = monotonic_ns();
   // 1. The frame on its own.
-  pipeline_.process(image, options_.mode, result_.get());
+  pipeline_.process(image, options_.mode, result_.get(), readout_motion(frame.timestamp_ns));
   out_.frame = frame;
   out_.measured = result_->estimate;
   out_.markers_decoded = result_->marker_count;
@@ -60,6 +63,31 @@ const Localization& Localizer::localize(const ImageView& image, const FrameInfo&
   refusals_.count(out_.refusal);
   out_.localize_ns = monotonic_ns() - start_ns;
   return out_;
+}
+
+CameraMotion Localizer::readout_motion(int64_t t_ns) const {
+  CameraMotion m;
+  const PipelineConfig& c = pipeline_.config();
+  if (!options_.filter || !filter_.initialised() || !(c.intrinsics.readout_ms > 0.0)) return m;
+  const MotionEstimate e{true, filter_.state_time_ns(), filter_.state(), filter_.jerk_density(),
+                         c.filter.predict_horizon_ms};
+  if (!(std::abs(static_cast<double>(t_ns - e.time_ns)) * 1e-6 <= e.horizon_ms)) return m;
+  const MotionState s = motion_at(e, t_ns);
+  constexpr int N = kMotionStates;
+  const double yaw = s.x[2], vx = s.x[3], vy = s.x[4], w = s.x[5];
+  // The optical centre sits at R(yaw)·offset from the robot: it moves by
+  // ω × that as well.
+  double rx = 0.0, ry = 0.0;
+  mount_offset_world(c.mount, yaw, &rx, &ry);
+  const double sigma_w = std::sqrt(s.p[5 * N + 5]);
+  m.valid = true;
+  m.vx_mps = vx - w * ry;
+  m.vy_mps = vy + w * rx;
+  m.yaw_rate_radps = w;
+  m.sigma_v_mps =
+      std::sqrt(std::max(s.p[3 * N + 3], s.p[4 * N + 4])) + sigma_w * std::hypot(rx, ry);
+  m.sigma_yaw_rate_radps = sigma_w;
+  return m;
 }
 
 }  // namespace ceilpose

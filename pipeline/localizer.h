@@ -51,6 +51,11 @@ class Localizer {
   Localization out_;
   bool had_fix_ = false;
   RefusalHistogram refusals_;
+
+  // The filter's motion predicted to t_ns and moved to the optical centre,
+  // for a rolling shutter's readout; invalid when there is no filter, no
+  // state within the prediction horizon or no readout.
+  CameraMotion readout_motion(int64_t t_ns) const;
 };
 
 }  // namespace ceilpose

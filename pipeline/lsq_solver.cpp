@@ -20,12 +20,17 @@ enum Param : int {
 };
 // The motion is estimated only from markers spread over at least this share
 // of the readout's rows, and at least this many of them; otherwise it is held
-// (at rest). Its prior (1 m/s, 3 rad/s per pixel of residual) only conditions
-// the solve when the rows barely tell it.
+// (at the filter's motion when the caller gives it, else at rest). Its prior
+// is the caller's motion, or rest with 1 m/s and 3 rad/s per pixel of
+// residual, which only conditions the solve when the rows barely tell it.
+// The caller's sigmas are floored: a filter that has just missed a turn must
+// not override what the rows say.
 constexpr double kMotionMinRowSpan = 0.3;
 constexpr int kMotionMinMarkers = 3;
 constexpr double kMotionPriorMps = 1.0;
 constexpr double kMotionPriorRadps = 3.0;
+constexpr double kMotionPriorFloorMps = 0.05;
+constexpr double kMotionPriorFloorRadps = 0.2;
 // Marker-level rejection passes after the first solve.
 constexpr int kMaxRejections = 3;
 
@@ -254,8 +259,13 @@ double LsqSolver::prior_cost(const ViewGeometry& view, const PositioningParams& 
                              const State& st, Normal* a, Vector* b) const {
   double motion = 0.0;
   if (active_[kVx]) {
-    const double wv = 1.0 / kMotionPriorMps, ww = 1.0 / kMotionPriorRadps;
-    const double r[3] = {wv * st.vx, wv * st.vy, ww * st.w};
+    const double wv = 1.0 / (motion_.valid ? std::max(motion_.sigma_v_mps, kMotionPriorFloorMps)
+                                           : kMotionPriorMps);
+    const double ww =
+        1.0 / (motion_.valid ? std::max(motion_.sigma_yaw_rate_radps, kMotionPriorFloorRadps)
+                             : kMotionPriorRadps);
+    const State held = held_motion(st);
+    const double r[3] = {wv * (st.vx - held.vx), wv * (st.vy - held.vy), ww * (st.w - held.w)};
     const double wt[3] = {wv, wv, ww};
     for (int k = 0; k < 3; ++k) {
       motion += r[k] * r[k];
@@ -276,6 +286,14 @@ double LsqSolver::prior_cost(const ViewGeometry& view, const PositioningParams& 
     (*b)[kTiltY] -= w * rb;
   }
   return motion + ra * ra + rb * rb;
+}
+
+LsqSolver::State LsqSolver::held_motion(const State& st) const {
+  State out = st;
+  out.vx = motion_.valid ? motion_.vx_mps : 0.0;
+  out.vy = motion_.valid ? motion_.vy_mps : 0.0;
+  out.w = motion_.valid ? motion_.yaw_rate_radps : 0.0;
+  return out;
 }
 
 bool LsqSolver::motion_observable(const ViewGeometry& view, std::span<const bool> use,
@@ -369,7 +387,7 @@ double LsqSolver::optimise(const ViewGeometry& view, const PositioningParams& pa
     if (*marker_count < params.lsq_tilt_min_markers) active_[kTiltX] = active_[kTiltY] = false;
     if (active_[kVx] && !motion_observable(view, use, *marker_count)) {
       active_[kVx] = active_[kVy] = active_[kYawRate] = false;
-      st.vx = st.vy = st.w = 0.0;
+      st = held_motion(st);
     }
   }
   return cost;
@@ -384,9 +402,6 @@ int LsqSolver::gather_points(const ViewGeometry& view, std::span<const MarkerObs
                              State* seed) {
   const CeilingLayout& layout = view.layout();
   const CameraIntrinsics& k = view.intrinsics();
-  // SPEC §3: row v is exposed (v - (height - 1)/2) / height * readout after
-  // the centre row.
-  const double row_s = k.readout_ms * 1e-3 / k.height;
   point_count_ = 0;
   int marker_count = 0;
   double sin_sum = 0.0, cos_sum = 0.0, x_sum = 0.0, y_sum = 0.0;
@@ -402,7 +417,7 @@ int LsqSolver::gather_points(const ViewGeometry& view, std::span<const MarkerObs
       }
       Point& p = points_[point_count_++];
       undistort_pixel(view.intrinsics(), u_px, v_px, &p.x_n, &p.y_n);
-      p.tau_s = (v_px - 0.5 * (k.height - 1)) * row_s;
+      p.tau_s = row_time_s(k, v_px);
       double x_m = 0.0, y_m = 0.0;
       fix.placement->world_point(e_m, n_m, &x_m, &y_m);
       p.world = {x_m, y_m, layout.height_m};
@@ -426,6 +441,7 @@ int LsqSolver::gather_points(const ViewGeometry& view, std::span<const MarkerObs
   if (marker_count > 0) {
     seed->t_w = {x_sum / marker_count, y_sum / marker_count, view.mount().lens_height_m};
     seed->r_wc = mat_mul(level_rotation(std::atan2(sin_sum, cos_sum)), view.tilt());
+    *seed = held_motion(*seed);
   }
   return marker_count;
 }
@@ -635,7 +651,9 @@ bool LsqSolver::robot_covariance(const ViewGeometry& view, const PositioningPara
 
 bool LsqSolver::solve(const ViewGeometry& view, const PositioningParams& params,
                       std::span<const MarkerObservation> markers, std::span<const MarkerFix> fixes,
-                      std::span<bool> use, LsqResult* out) {
+                      std::span<bool> use, const CameraMotion& motion, LsqResult* out) {
+  // A global shutter has no motion within the frame to hold or estimate.
+  motion_ = view.intrinsics().readout_ms > 0.0 ? motion : CameraMotion{};
   State st;
   std::array<bool, kMaxMarkersPerFrame> consistent{};
   std::copy(use.begin(), use.end(), consistent.begin());
@@ -671,6 +689,7 @@ bool LsqSolver::solve(const ViewGeometry& view, const PositioningParams& params,
   out->lens_height_m = st.t_w[2];
   out->tilt_estimated = tilt_estimated;
   out->motion_estimated = active_[kVx];
+  out->motion_held = !active_[kVx] && motion_.valid;
   out->cam_vx_mps = st.vx;
   out->cam_vy_mps = st.vy;
   out->yaw_rate_radps = st.w;

@@ -33,6 +33,7 @@ struct LsqResult {
   double cam_vy_mps = 0.0;
   double yaw_rate_radps = 0.0;
   bool motion_estimated = false;
+  bool motion_held = false;  // not estimated: held at the caller's motion
 };
 
 // Holds the per-frame work arrays (sized for the largest frame), so solve()
@@ -43,11 +44,13 @@ class LsqSolver {
 
   // `use` flags the markers (indices into fixes) to solve from; markers
   // rejected as outliers are cleared in it. Seeds from the fixes' Change of
-  // Axes answers. False when too few points, no convergence or the residual
-  // stays above params.lsq_max_rms_px.
+  // Axes answers. `motion` (when valid, rolling shutter only) is the prior of
+  // the motion during the readout, and its value when the rows cannot tell
+  // it. False when too few points, no convergence or the residual stays
+  // above params.lsq_max_rms_px.
   bool solve(const ViewGeometry& view, const PositioningParams& params,
              std::span<const MarkerObservation> markers, std::span<const MarkerFix> fixes,
-             std::span<bool> use, LsqResult* out);
+             std::span<bool> use, const CameraMotion& motion, LsqResult* out);
 
  private:
   struct Point {
@@ -90,6 +93,8 @@ class LsqSolver {
                   int* iterations);
   double prior_cost(const ViewGeometry& view, const PositioningParams& params, const State& state,
                     Normal* a, Vector* b) const;
+  // `st` with the motion it is held at when not estimated.
+  State held_motion(const State& st) const;
   // Whether the points span enough rows (and markers) to estimate the motion.
   bool motion_observable(const ViewGeometry& view, std::span<const bool> use,
                          int marker_count) const;
@@ -120,6 +125,7 @@ class LsqSolver {
   int point_count_ = 0;
   std::array<bool, kParams> active_{};
   std::array<MarkerTerm, kMaxMarkersPerFrame> marker_terms_{};
+  CameraMotion motion_;  // this solve's
 };
 
 }  // namespace ceilpose

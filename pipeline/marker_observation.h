@@ -34,7 +34,7 @@ struct MarkerObservation {
   // Image angle of the red→green vector, atan2(dv, du): the direction of
   // world West as seen in the image.
   double west_image_rad = 0.0;
-  bool whole = true;  // the entire outline lies inside the image
+  bool whole = true;     // the entire outline lies inside the image
   float quality = 1.0f;  // 0..1, fit quality (template fill, dot contrast)
   int point_count = 0;
   std::array<MarkerPointObservation, kMaxPointsPerMarker> points{};

@@ -149,7 +149,8 @@ Refusal Pipeline::refusal_without_markers(const FrameResult& result, size_t pair
   return Refusal::kUnreadableMarkers;
 }
 
-void Pipeline::process(const ImageView& frame, PositioningMode mode, FrameResult* out) {
+void Pipeline::process(const ImageView& frame, PositioningMode mode, FrameResult* out,
+                       const CameraMotion& motion) {
   const int64_t start_ns = monotonic_ns();
   int64_t stamp_ns = start_ns;
   auto lap = [&](int stage) {
@@ -201,7 +202,8 @@ void Pipeline::process(const ImageView& frame, PositioningMode mode, FrameResult
   if (out->marker_count == 0) {
     out->estimate = refused_estimate(refusal_without_markers(*out, pair_count_));
   } else {
-    out->estimate = positioner_.solve(std::span(out->markers.data(), out->marker_count), mode);
+    out->estimate =
+        positioner_.solve(std::span(out->markers.data(), out->marker_count), mode, motion);
   }
   lap(kStagePositioning);
   out->total_ns = stamp_ns - start_ns;

@@ -88,7 +88,10 @@ class Pipeline {
   // Processes one frame. A frame of another size than the configured
   // intrinsics, compressed, empty or malformed, gives an invalid estimate
   // (refusal unusable_frame) and no markers.
-  void process(const ImageView& frame, PositioningMode mode, FrameResult* out);
+  // `motion`: the camera's motion during the readout when known from
+  // elsewhere (rolling shutter; see Positioner::solve).
+  void process(const ImageView& frame, PositioningMode mode, FrameResult* out,
+               const CameraMotion& motion = {});
 
   // Replaces the configuration (SIGHUP reload of thresholds); rebuilds the
   // colour table and re-allocates only if the image size changed. Not in the

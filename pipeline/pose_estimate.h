@@ -20,6 +20,11 @@ struct PoseEstimate {
   // fewer than two markers. Set on refused estimates too, so that callers can
   // say why a view full of markers gives no pose.
   double depth_scale = 0.0;
+  // Rolling shutter: when the rows the pose was measured from were exposed,
+  // seconds after the frame's time (the centre row). 0 for a global shutter
+  // and when the solve modelled the motion within the frame. The temporal
+  // filter fuses the pose at that instant.
+  double time_offset_s = 0.0;
   // Why there is no pose (kNone when valid): set by the stage that refused.
   Refusal refusal = Refusal::kNone;
 };

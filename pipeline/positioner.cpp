@@ -63,7 +63,7 @@ double Positioner::depth_scale(int fix_count) {
 
 // Thesis Change of Axes uses one marker: the consistent one nearest the
 // image centre, where tilt and distortion errors are smallest.
-PoseEstimate Positioner::change_of_axes(int fix_count) const {
+PoseEstimate Positioner::change_of_axes(int fix_count) {
   PoseEstimate est;
   int best = -1;
   double best_r2 = 0.0;
@@ -77,6 +77,8 @@ PoseEstimate Positioner::change_of_axes(int fix_count) const {
     }
   }
   if (best < 0) return est;
+  use_.fill(false);
+  use_[best] = true;
   const MarkerFix& f = fixes_[best];
   est.pose = view_.robot_from_camera(f.cam_x_m, f.cam_y_m, f.cam_yaw_rad);
   est.valid = true;
@@ -86,12 +88,15 @@ PoseEstimate Positioner::change_of_axes(int fix_count) const {
   return est;
 }
 
-PoseEstimate Positioner::barycentric(int fix_count) const {
+PoseEstimate Positioner::barycentric(int fix_count) {
   PoseEstimate est;
+  std::array<int, 3> chosen{};
   if (!solve_barycentric(view_, params_, std::span(fixes_.data(), fix_count),
-                         std::span(inlier_.data(), fix_count), &est.pose)) {
+                         std::span(inlier_.data(), fix_count), &est.pose, &chosen)) {
     return est;
   }
+  use_.fill(false);
+  for (int k : chosen) use_[k] = true;
   est.valid = true;
   est.mode = PositioningMode::kBarycentric;
   est.markers = 3;
@@ -99,12 +104,13 @@ PoseEstimate Positioner::barycentric(int fix_count) const {
   return est;
 }
 
-PoseEstimate Positioner::least_squares(std::span<const MarkerObservation> markers, int fix_count) {
+PoseEstimate Positioner::least_squares(std::span<const MarkerObservation> markers, int fix_count,
+                                       const CameraMotion& motion) {
   PoseEstimate est;
   for (int k = 0; k < fix_count; ++k) use_[k] = inlier_[k];
   lsq_result_ = LsqResult{};
   if (!lsq_.solve(view_, params_, markers, std::span(fixes_.data(), fix_count),
-                  std::span(use_.data(), fix_count), &lsq_result_)) {
+                  std::span(use_.data(), fix_count), motion, &lsq_result_)) {
     return est;
   }
   est.valid = true;
@@ -116,14 +122,16 @@ PoseEstimate Positioner::least_squares(std::span<const MarkerObservation> marker
   return est;
 }
 
-PoseEstimate Positioner::solve(std::span<const MarkerObservation> markers, PositioningMode mode) {
-  // 1. What each whole marker says on its own (Change of Axes).
+PoseEstimate Positioner::solve(std::span<const MarkerObservation> markers, PositioningMode mode,
+                               const CameraMotion& motion) {
+  // 1. What each whole marker says on its own (Change of Axes), at the
+  // centre row's instant when the motion during the readout is known.
   int fix_count = 0, whole = 0;
   const int n = static_cast<int>(std::min<size_t>(markers.size(), kMaxMarkersPerFrame));
   for (int k = 0; k < n; ++k) {
     if (!markers[k].whole) continue;
     ++whole;
-    if (marker_fix(view_, markers[k], k, &fixes_[fix_count])) ++fix_count;
+    if (marker_fix(view_, markers[k], k, motion, &fixes_[fix_count])) ++fix_count;
   }
   if (fix_count == 0)
     return refused_estimate(whole > 0 && view_.map().surveyed() ? Refusal::kUnmappedMarkers
@@ -140,8 +148,9 @@ PoseEstimate Positioner::solve(std::span<const MarkerObservation> markers, Posit
   if (depth_scale_contradicts_heights(params_, scale))
     return refused_estimate(Refusal::kWrongHeights, scale);
   // 4. The mode asked for, or in auto the best the view allows.
-  PoseEstimate est = solve_mode(markers, fix_count, mode);
+  PoseEstimate est = solve_mode(markers, fix_count, mode, motion);
   est.depth_scale = scale;
+  if (est.valid) time_the_pose(markers, fix_count, motion, &est);
   if (!est.valid) {
     // A solver given fewer markers than it needs did not fail: the view did.
     int inlier_points = 0;
@@ -156,22 +165,54 @@ PoseEstimate Positioner::solve(std::span<const MarkerObservation> markers, Posit
 }
 
 PoseEstimate Positioner::solve_mode(std::span<const MarkerObservation> markers, int fix_count,
-                                    PositioningMode mode) {
+                                    PositioningMode mode, const CameraMotion& motion) {
   switch (mode) {
     case PositioningMode::kChangeOfAxes:
       return change_of_axes(fix_count);
     case PositioningMode::kBarycentric:
       return barycentric(fix_count);
     case PositioningMode::kLeastSquares:
-      return least_squares(markers, fix_count);
+      return least_squares(markers, fix_count, motion);
     case PositioningMode::kAuto:
       break;
   }
-  PoseEstimate est = least_squares(markers, fix_count);
+  PoseEstimate est = least_squares(markers, fix_count, motion);
   if (est.valid) return est;
   est = barycentric(fix_count);
   if (est.valid) return est;
   return change_of_axes(fix_count);
+}
+
+// Rolling shutter, the motion within the frame not estimated from it: a pose
+// from the markers' rows is the pose of when those rows were exposed. Told
+// the camera's motion, the markers were compared and combined at the centre
+// row; the pose is carried back to their rows' instant, so that it does not
+// depend on the motion it was told: fed back through the filter, a told
+// yaw rate that moved a lone marker's heading would raise itself.
+void Positioner::time_the_pose(std::span<const MarkerObservation> markers, int fix_count,
+                               const CameraMotion& motion, PoseEstimate* est) const {
+  const CameraIntrinsics& k = view_.intrinsics();
+  if (!(k.readout_ms > 0.0)) return;
+  if (est->mode == PositioningMode::kLeastSquares && lsq_result_.motion_estimated) return;
+  double tau_sum_s = 0.0;
+  int used = 0;
+  for (int f = 0; f < fix_count; ++f) {
+    if (!use_[f]) continue;
+    tau_sum_s += row_time_s(k, markers[fixes_[f].index].centre_v_px);
+    ++used;
+  }
+  if (used == 0) return;
+  const double tau_s = tau_sum_s / used;
+  est->time_offset_s = tau_s;
+  if (!motion.valid) return;
+  const double yaw = est->pose.yaw_rad;
+  const CameraMount& m = view_.mount();
+  double ox_m = 0.0, oy_m = 0.0;
+  mount_offset_world(m, yaw, &ox_m, &oy_m);
+  const double cam_x_m = est->pose.x_m + ox_m, cam_y_m = est->pose.y_m + oy_m;
+  est->pose =
+      view_.robot_from_camera(cam_x_m + motion.vx_mps * tau_s, cam_y_m + motion.vy_mps * tau_s,
+                              yaw + m.yaw_rad + motion.yaw_rate_radps * tau_s);
 }
 
 }  // namespace ceilpose

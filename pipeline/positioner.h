@@ -22,20 +22,27 @@ class Positioner {
   // estimate is invalid when no whole marker is seen, the markers disagree
   // with no majority, or the mode asked for cannot be applied to this view
   // (e.g. barycentric with fewer than three markers) — never a made-up pose.
-  PoseEstimate solve(std::span<const MarkerObservation> markers, PositioningMode mode);
+  // `motion` (rolling shutter): the camera's motion during the readout when
+  // known from elsewhere; each marker's answer is moved to the centre row by
+  // it, and lsq holds it when the rows cannot tell the motion.
+  PoseEstimate solve(std::span<const MarkerObservation> markers, PositioningMode mode,
+                     const CameraMotion& motion = {});
 
   // Details of the last least-squares solve (tilt, iterations), for
   // diagnostics and tests.
   const LsqResult& last_lsq() const { return lsq_result_; }
 
  private:
-  PoseEstimate change_of_axes(int fix_count) const;
-  PoseEstimate barycentric(int fix_count) const;
-  PoseEstimate least_squares(std::span<const MarkerObservation> markers, int fix_count);
+  PoseEstimate change_of_axes(int fix_count);
+  PoseEstimate barycentric(int fix_count);
+  PoseEstimate least_squares(std::span<const MarkerObservation> markers, int fix_count,
+                             const CameraMotion& motion);
   void set_thesis_covariance(PoseEstimate* estimate, int fix_count) const;
   double depth_scale(int fix_count);
   PoseEstimate solve_mode(std::span<const MarkerObservation> markers, int fix_count,
-                          PositioningMode mode);
+                          PositioningMode mode, const CameraMotion& motion);
+  void time_the_pose(std::span<const MarkerObservation> markers, int fix_count,
+                     const CameraMotion& motion, PoseEstimate* est) const;
 
   PositioningParams params_;
   ViewGeometry view_;
@@ -43,7 +50,7 @@ class Positioner {
   LsqResult lsq_result_;
   std::array<MarkerFix, kMaxMarkersPerFrame> fixes_{};
   std::array<bool, kMaxMarkersPerFrame> inlier_{};
-  std::array<bool, kMaxMarkersPerFrame> use_{};
+  std::array<bool, kMaxMarkersPerFrame> use_{};  // lsq's, then the mode's markers
   std::array<double, kMaxMarkersPerFrame*(kMaxMarkersPerFrame - 1) / 2> pair_scales_{};
 };
 

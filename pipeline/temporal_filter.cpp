@@ -71,12 +71,17 @@ void TemporalFilter::predict(double dt) {
   state_.x[2] = wrap_angle_rad(state_.x[2]);
 }
 
-PoseEstimate TemporalFilter::output(const PoseEstimate* used) const {
+PoseEstimate TemporalFilter::output(const PoseEstimate* used, int64_t timestamp_ns) const {
+  // The state may be a rolling shutter's few milliseconds off the frame.
+  MotionState at = state_;
+  if (timestamp_ns != last_ns_)
+    propagate_motion(state_, static_cast<double>(timestamp_ns - last_ns_) * 1e-9, jerk_density(),
+                     &at, 1);
   PoseEstimate out;
   out.valid = true;
-  out.pose = {state_.x[0], state_.x[1], wrap_angle_rad(state_.x[2])};
+  out.pose = {at.x[0], at.x[1], wrap_angle_rad(at.x[2])};
   for (int r = 0; r < 3; ++r)
-    for (int c = 0; c < 3; ++c) out.covariance[r * 3 + c] = state_.p[r * kN + c];
+    for (int c = 0; c < 3; ++c) out.covariance[r * 3 + c] = at.p[r * kN + c];
   out.mode = used != nullptr ? used->mode : last_mode_;
   out.markers = used != nullptr ? used->markers : 0;
   out.rms_residual_px = used != nullptr ? used->rms_residual_px : 0.0;
@@ -139,7 +144,9 @@ void TemporalFilter::correct(const std::array<double, 3>& y, const std::array<do
   state_.p = p;
 }
 
-PoseEstimate TemporalFilter::update(const PoseEstimate& m, int64_t timestamp_ns) {
+PoseEstimate TemporalFilter::update(const PoseEstimate& m, int64_t frame_ns) {
+  const int64_t timestamp_ns =
+      m.valid ? frame_ns + static_cast<int64_t>(std::llround(m.time_offset_s * 1e9)) : frame_ns;
   const double timeout_ns = params_.predict_timeout_ms * 1e6;
   if (initialised_ && static_cast<double>(timestamp_ns - last_measurement_ns_) > timeout_ns) {
     initialised_ = false;
@@ -149,7 +156,7 @@ PoseEstimate TemporalFilter::update(const PoseEstimate& m, int64_t timestamp_ns)
     if (!m.valid) return PoseEstimate{};
     initialise(m, timestamp_ns);
     ++stats_.updates;
-    return output(&m);
+    return output(&m, frame_ns);
   }
   predict(std::max<int64_t>(0, timestamp_ns - last_ns_) * 1e-9);
   last_ns_ = std::max(last_ns_, timestamp_ns);
@@ -157,7 +164,7 @@ PoseEstimate TemporalFilter::update(const PoseEstimate& m, int64_t timestamp_ns)
   std::array<double, 9> s_inv{};
   if (!m.valid || !innovation(m, &y, &s_inv)) {
     ++stats_.predictions;
-    return output(nullptr);
+    return output(nullptr, frame_ns);
   }
   if (gated(y, s_inv)) {
     ++stats_.gated;
@@ -166,17 +173,17 @@ PoseEstimate TemporalFilter::update(const PoseEstimate& m, int64_t timestamp_ns)
       // enough: the robot was moved or the filter diverged.
       ++stats_.reinitialisations;
       initialise(m, timestamp_ns);
-      return output(&m);
+      return output(&m, frame_ns);
     }
     ++stats_.predictions;
-    return output(nullptr);
+    return output(nullptr, frame_ns);
   }
   correct(y, s_inv);
   consecutive_gated_ = 0;
   last_measurement_ns_ = timestamp_ns;
   last_mode_ = m.mode;
   ++stats_.updates;
-  return output(&m);
+  return output(&m, frame_ns);
 }
 
 }  // namespace ceilpose

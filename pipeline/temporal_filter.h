@@ -27,15 +27,17 @@ class TemporalFilter {
  public:
   explicit TemporalFilter(const FilterParams& params);
 
-  // Fuses one frame's estimate (valid or not) taken at `timestamp_ns`
-  // (monotonic) and returns the filtered pose; invalid until a first valid
-  // measurement and again once predict_timeout_ms passes without one. A
-  // timestamp earlier than the previous one is treated as the same instant.
+  // Fuses one frame's estimate (valid or not) of the frame taken at
+  // `timestamp_ns` (monotonic), at the instant the estimate refers to
+  // (timestamp_ns + its time_offset_s), and returns the filtered pose at
+  // timestamp_ns; invalid until a first valid measurement and again once
+  // predict_timeout_ms passes without one. An instant earlier than the
+  // previous one is treated as the same instant.
   PoseEstimate update(const PoseEstimate& measurement, int64_t timestamp_ns);
   void reset();
 
   const FilterStats& stats() const { return stats_; }
-  // The state at the last update's timestamp; meaningful while initialised().
+  // The state at the last update's instant; meaningful while initialised().
   bool initialised() const { return initialised_; }
   const MotionState& state() const { return state_; }
   int64_t state_time_ns() const { return last_ns_; }
@@ -49,7 +51,7 @@ class TemporalFilter {
                   std::array<double, 9>* s_inv) const;
   bool gated(const std::array<double, 3>& y, const std::array<double, 9>& s_inv) const;
   void correct(const std::array<double, 3>& y, const std::array<double, 9>& s_inv);
-  PoseEstimate output(const PoseEstimate* used) const;
+  PoseEstimate output(const PoseEstimate* used, int64_t timestamp_ns) const;
 
   FilterParams params_;
   FilterStats stats_;

@@ -81,8 +81,10 @@ void Renderer::render_rolling(const PoseAt& pose_at, double readout_s, const Cam
   const int h = options_.intrinsics.height;
   // One camera pose per pixel row (allocated once: the size never changes).
   row_poses_.resize(static_cast<size_t>(h));
+  CameraIntrinsics k = options_.intrinsics;
+  k.readout_ms = readout_s * 1e3;
   for (int r = 0; r < h; ++r) {
-    const double dt_s = (r - 0.5 * (h - 1)) / h * readout_s;
+    const double dt_s = row_time_s(k, r);
     row_poses_[static_cast<size_t>(r)] = camera_pose_from_robot(pose_at(dt_s), mount);
   }
   render_rows([&](int r) -> const CameraPose& { return row_poses_[static_cast<size_t>(r)]; }, false,

@@ -49,8 +49,9 @@ TEST(Barycentric, RefusesCollinearMarkers) {
   ASSERT_GE(fixes.size(), 3u);
   const bool use[kMaxMarkersPerFrame] = {true, true, true, true, true, true, true, true};
   Pose2D robot;
-  EXPECT_FALSE(
-      solve_barycentric(view, config.positioning, fixes, std::span(use, fixes.size()), &robot));
+  std::array<int, 3> chosen{};
+  EXPECT_FALSE(solve_barycentric(view, config.positioning, fixes, std::span(use, fixes.size()),
+                                 &robot, &chosen));
 }
 
 TEST(Barycentric, SmallPixelNoiseGivesSmallError) {

@@ -79,7 +79,7 @@ TEST(ChangeOfAxes, RejectsCodeOutsideTheLayout) {
   ASSERT_FALSE(markers.empty());
   markers[0].code_i = 8;
   MarkerFix fix;
-  EXPECT_FALSE(marker_fix(view, markers[0], 0, &fix));
+  EXPECT_FALSE(marker_fix(view, markers[0], 0, {}, &fix));
 }
 
 }  // namespace

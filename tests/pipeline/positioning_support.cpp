@@ -71,7 +71,7 @@ std::vector<MarkerFix> fixes_of(const ViewGeometry& view,
   std::vector<MarkerFix> fixes;
   for (size_t k = 0; k < markers.size(); ++k) {
     MarkerFix f;
-    if (marker_fix(view, markers[k], static_cast<int>(k), &f)) fixes.push_back(f);
+    if (marker_fix(view, markers[k], static_cast<int>(k), {}, &f)) fixes.push_back(f);
   }
   return fixes;
 }

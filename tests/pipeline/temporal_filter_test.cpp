@@ -61,6 +61,34 @@ TEST(TemporalFilter, TracksConstantVelocityWithoutLag) {
   EXPECT_NEAR(out.pose.x_m, 0.5 * t_end, 0.002);
 }
 
+// A rolling shutter's lone marker measures the robot when its row was
+// exposed (time_offset_s after the frame): fused at that instant, the pose
+// returned is still the frame's; taken as the frame's, it would be off by
+// v·offset.
+TEST(TemporalFilter, FusesAPoseAtItsRowsInstantAndAnswersForTheFrame) {
+  TemporalFilter at_rows{FilterParams{}}, as_frame{FilterParams{}};
+  constexpr double kSpeedMps = 1.5, kYawRateRadps = 2.0;
+  PoseEstimate rows_out, frame_out;
+  for (int k = 0; k < 60; ++k) {
+    const double t_s = k * kFrameNs * 1e-9;
+    const double offset_s = (k % 2 == 0 ? 1.0 : -1.0) * 0.010;  // the marker's row moves
+    PoseEstimate m =
+        measurement(kSpeedMps * (t_s + offset_s), 1.0, kYawRateRadps * (t_s + offset_s));
+    m.time_offset_s = offset_s;
+    rows_out = at_rows.update(m, k * kFrameNs);
+    m.time_offset_s = 0.0;
+    frame_out = as_frame.update(m, k * kFrameNs);
+  }
+  const double t_end_s = 59 * kFrameNs * 1e-9;
+  EXPECT_NEAR(rows_out.pose.x_m, kSpeedMps * t_end_s, 0.0005);
+  EXPECT_NEAR(rows_out.pose.yaw_rad, wrap_angle_rad(kYawRateRadps * t_end_s), 0.001);
+  EXPECT_NEAR(at_rows.state().x[3], kSpeedMps, 0.02);
+  EXPECT_GT(std::abs(frame_out.pose.x_m - kSpeedMps * t_end_s), 0.005)
+      << "the offset must matter for the test to mean anything";
+  // The state refers to the last measurement's instant.
+  EXPECT_EQ(at_rows.state_time_ns(), 59 * kFrameNs - 10'000'000);
+}
+
 // A robot speeding up on a circle: the constant-acceleration model follows
 // it without lag and its state carries the velocity, yaw rate and the
 // centripetal acceleration a controller's prediction needs.
