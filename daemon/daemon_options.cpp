@@ -1,12 +1,45 @@
 #include "daemon/daemon_options.h"
 
 #include <CLI/CLI.hpp>
+#include <cmath>
 #include <cstdio>
+#include <exception>
+#include <string>
 
 #include "capture/source_spec.h"
 #include "daemon/exit_codes.h"
 
 namespace ceilpose::daemon {
+namespace {
+
+// `--source "$CAM"` with CAM unset must not mean "the default source": on a
+// robot that would be the simulator's poses published as real ones.
+const CLI::Validator kNotEmpty(
+    [](const std::string& value) {
+      return value.empty()
+                 ? std::string("must not be empty (an unset variable in a launch script?)")
+                 : std::string();
+    },
+    "NOT EMPTY");
+
+// A finite number of seconds above 0: nan or 0 would never stop.
+const CLI::Validator kPositiveSeconds(
+    [](const std::string& value) {
+      double s = 0.0;
+      try {
+        size_t used = 0;
+        s = std::stod(value, &used);
+        if (used != value.size()) s = 0.0;
+      } catch (const std::exception&) {
+        s = 0.0;
+      }
+      return std::isfinite(s) && s > 0.0
+                 ? std::string()
+                 : "must be a number of seconds above 0, got '" + value + "'";
+    },
+    "SECONDS > 0");
+
+}  // namespace
 
 bool parse_command_line(int argc, char** argv, DaemonOptions* options, int* exit_code) {
   CLI::App app{
@@ -23,22 +56,26 @@ bool parse_command_line(int argc, char** argv, DaemonOptions* options, int* exit
   bool no_dds = false;
   // Not CLI::ExistingFile: a missing file is a configuration error (exit 3)
   // reported by the loader like any other.
-  app.add_option("--config", options->config_path,
-                 "YAML configuration file (config/ceilpose.yaml)");
-  app.add_option("--source", source, "frame source: " + std::string(capture::kSourceSpecForms));
-  app.add_option("--robot", robot, "robot name, the DDS topic prefix (default: host name)");
-  app.add_option("--shm", shm, "shared-memory segment name (default /ceilpose)");
+  app.add_option("--config", options->config_path, "YAML configuration file (config/ceilpose.yaml)")
+      ->check(kNotEmpty);
+  app.add_option("--source", source, "frame source: " + std::string(capture::kSourceSpecForms))
+      ->check(kNotEmpty);
+  app.add_option("--robot", robot, "robot name, the DDS topic prefix (default: host name)")
+      ->check(kNotEmpty);
+  app.add_option("--shm", shm, "shared-memory segment name (default /ceilpose)")->check(kNotEmpty);
   app.add_option("--domain", domain, "DDS domain id (default 0)");
   app.add_flag("--no-dds", no_dds, "publish on shared memory only");
-  app.add_option("--log-level", log_level, "trace | debug | info | warn | error | critical | off");
+  app.add_option("--log-level", log_level, "trace | debug | info | warn | error | critical | off")
+      ->check(kNotEmpty);
   app.add_option("--duration", options->duration_s,
-                 "stop after SECONDS (default: run until stopped)")
-      ->check(CLI::NonNegativeNumber);
+                 "stop after SECONDS, a number above 0 (default: run until stopped)")
+      ->check(kPositiveSeconds);
   app.add_flag("--print-poses", options->print_poses,
                "print a line per pose (at most 10 per second): time, x, y, yaw, mode, markers,\n"
                "ground truth and error when the source knows it, latency");
   app.add_option("--check-config", options->check_config_path,
-                 "validate FILE and exit: 0 when valid, 3 with the problem on stderr");
+                 "validate FILE and exit: 0 when valid, 3 with the problem on stderr")
+      ->check(kNotEmpty);
   app.add_flag("--print-config", options->print_config,
                "print the effective configuration (file + options) as YAML and exit");
 

@@ -11,11 +11,15 @@
 #include <cstdlib>
 #include <mutex>
 
+#include "daemon/nonblocking_write.h"
+
 namespace ceilpose::daemon {
 namespace {
 
 // Writes "<N>" + the formatted message to stderr, unbuffered, one write per line
 // so lines of different threads never interleave inside journald's stream.
+// Never blocks: a stderr pipe nobody reads loses lines instead of stopping
+// the thread that logs (nonblocking_write.h).
 class JournalSink : public spdlog::sinks::base_sink<std::mutex> {
  protected:
   void sink_it_(const spdlog::details::log_msg& msg) override {
@@ -25,9 +29,9 @@ class JournalSink : public spdlog::sinks::base_sink<std::mutex> {
     spdlog::memory_buf_t body;
     formatter_->format(msg, body);
     formatted.append(body.data(), body.data() + body.size());
-    std::fwrite(formatted.data(), 1, formatted.size(), stderr);
+    (void)write_without_blocking(STDERR_FILENO, formatted.data(), formatted.size());
   }
-  void flush_() override { std::fflush(stderr); }
+  void flush_() override {}
 };
 
 // True when stderr is the stream JOURNAL_STREAM names ("<dev>:<inode>"), the

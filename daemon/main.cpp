@@ -1,5 +1,8 @@
 // ceilposed: the ceiling-marker positioning service (SPEC §7, docs/service.md).
+#include <cerrno>
+#include <csignal>
 #include <cstdio>
+#include <cstring>
 #include <exception>
 
 #include "daemon/daemon_options.h"
@@ -7,9 +10,25 @@
 #include "daemon/logging.h"
 #include "daemon/service.h"
 
+namespace {
+
+// Output lost (/dev/full, a closed pipe) is a failure, not a success.
+int flushed(int exit_code) {
+  if (std::fflush(stdout) != 0 || std::ferror(stdout)) {
+    std::fprintf(stderr, "ceilposed: cannot write to stdout: %s\n", std::strerror(errno));
+    return ceilpose::daemon::kExitRuntime;
+  }
+  return exit_code;
+}
+
+}  // namespace
+
 int main(int argc, char** argv) {
   using namespace ceilpose;
   using namespace ceilpose::daemon;
+  // A reader that goes away (`ceilposed ... | head`) must give write errors,
+  // which are handled, not a death that leaves the segment marked dead.
+  std::signal(SIGPIPE, SIG_IGN);
   DaemonOptions options;
   int exit_code = kExitOk;
   if (!parse_command_line(argc, argv, &options, &exit_code)) return exit_code;
@@ -22,7 +41,7 @@ int main(int argc, char** argv) {
       return kExitBadConfig;
     }
     std::printf("%s: valid\n", options.check_config_path.c_str());
-    return kExitOk;
+    return flushed(kExitOk);
   }
 
   auto config = resolve_config(options);
@@ -32,7 +51,7 @@ int main(int argc, char** argv) {
   }
   if (options.print_config) {
     std::fputs(dump_config(*config).c_str(), stdout);
-    return kExitOk;
+    return flushed(kExitOk);
   }
 
   setup_logging(detect_log_target(), config->logging.level);

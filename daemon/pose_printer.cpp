@@ -1,9 +1,16 @@
 #include "daemon/pose_printer.h"
 
+#include <spdlog/spdlog.h>
+#include <unistd.h>
+
+#include <cerrno>
 #include <cmath>
 #include <cstdio>
+#include <cstring>
 #include <numbers>
 #include <string_view>
+
+#include "daemon/nonblocking_write.h"
 
 namespace ceilpose::daemon {
 
@@ -16,7 +23,7 @@ std::string status_line(const PoseSnapshot& s, const capture::FrameLatency& late
   return buf;
 }
 
-void print_pose(const PoseSnapshot& s, int64_t start_ns) {
+std::string pose_line(const PoseSnapshot& s, int64_t start_ns) {
   constexpr double kDeg = 180.0 / std::numbers::pi;
   const double t_s = static_cast<double>(s.capture_ns - start_ns) * 1e-9;
   char line[320];
@@ -46,8 +53,38 @@ void print_pose(const PoseSnapshot& s, int64_t start_ns) {
   if (n > 0 && n < static_cast<int>(sizeof(line)))
     std::snprintf(line + n, sizeof(line) - n, "  | latency %.2f ms",
                   static_cast<double>(s.latency_ns) * 1e-6);
-  std::printf("%s\n", line);
-  std::fflush(stdout);
+  return std::string(line) + "\n";
+}
+
+void PosePrinter::print(const PoseSnapshot& s) {
+  if (stopped_) return;
+  const std::string line = pose_line(s, start_ns_);
+  switch (write_without_blocking(STDOUT_FILENO, line.data(), line.size())) {
+    case WriteOutcome::kWritten:
+      ++printed_;
+      return;
+    case WriteOutcome::kDropped:
+      if (dropped_++ == 0)
+        spdlog::warn(
+            "--print-poses: stdout is not being read; pose lines are dropped, not waited for");
+      return;
+    case WriteOutcome::kClosed:
+      stopped_ = true;
+      spdlog::warn("--print-poses: stdout was closed by its reader after {} lines; printing stops",
+                   printed_);
+      return;
+    case WriteOutcome::kFailed:
+      stopped_ = true;
+      spdlog::warn("--print-poses: cannot write to stdout ({}) after {} lines; printing stops",
+                   std::strerror(errno), printed_);
+      return;
+  }
+}
+
+PosePrinter::~PosePrinter() {
+  if (dropped_ > 0)
+    spdlog::warn("--print-poses: {} pose lines dropped because stdout was not read ({} printed)",
+                 dropped_, printed_);
 }
 
 }  // namespace ceilpose::daemon

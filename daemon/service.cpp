@@ -240,6 +240,7 @@ void Service::loop() {
   int64_t next_problems = now + problem_period_ns;
   int64_t next_print = now;
   uint64_t printed_frame = 0;
+  PosePrinter printer(start_ns_);
   bool stalled_reported = false;
 
   for (;;) {
@@ -298,7 +299,7 @@ void Service::loop() {
       const PoseSnapshot s = worker_->latest();
       if (s.frame != printed_frame && s.frame != 0) {
         printed_frame = s.frame;
-        print_pose(s, start_ns_);
+        printer.print(s);
       }
     }
   }

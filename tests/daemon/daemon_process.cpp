@@ -26,9 +26,10 @@ std::string temp_path(const std::string& stem) {
          std::to_string(g_counter.fetch_add(1)) + "-" + stem;
 }
 
-ChildOptions daemon_options(const std::map<std::string, std::string>& env) {
+ChildOptions daemon_options(const std::map<std::string, std::string>& env, int stdout_fd) {
   ChildOptions options;
   options.capture_stderr = true;
+  options.stdout_fd = stdout_fd;
   // A test never inherits the systemd protocol from whoever runs ctest.
   options.env = {{"NOTIFY_SOCKET", ""}, {"WATCHDOG_USEC", ""}, {"WATCHDOG_PID", ""}};
   for (const auto& [name, value] : env) options.env[name] = value;
@@ -86,8 +87,8 @@ bool NotifySocket::wait_for(const std::string& line, int timeout_ms) {
 }
 
 DaemonProcess::DaemonProcess(const std::vector<std::string>& args,
-                             const std::map<std::string, std::string>& env)
-    : ChildProcess(daemon_argv(args), daemon_options(env)) {
+                             const std::map<std::string, std::string>& env, int stdout_fd)
+    : ChildProcess(daemon_argv(args), daemon_options(env, stdout_fd)) {
   if (!started()) throw std::runtime_error(start_error());
 }
 

@@ -38,8 +38,9 @@ class DaemonProcess : public ChildProcess {
  public:
   // Starts ceilposed with `args`; `env` adds to (or, with an empty value,
   // removes from) the test's environment. Throws when it cannot start.
-  DaemonProcess(const std::vector<std::string>& args,
-                const std::map<std::string, std::string>& env);
+  // `stdout_fd` >= 0: the daemon's stdout (not captured), see ChildOptions.
+  DaemonProcess(const std::vector<std::string>& args, const std::map<std::string, std::string>& env,
+                int stdout_fd = -1);
   // What the daemon logged so far: the tests' failure messages.
   const std::string& err() { return error_output(); }
 };

@@ -30,6 +30,9 @@ struct ChildOptions {
   // Kept per stream; output past it is still read (the child never blocks
   // on a full pipe) and dropped.
   size_t max_output_bytes = size_t{16} << 20;
+  // >= 0: the child's stdout is this descriptor (a pipe the test never
+  // reads, a closed pipe, /dev/full) instead of a captured pipe.
+  int stdout_fd = -1;
 };
 
 class ChildProcess {
