@@ -7,6 +7,7 @@
 #include <string>
 #include <vector>
 
+#include "config/cli_checks.h"
 #include "core/clock.h"
 #include "core/json_text.h"
 #include "ctl/command_registry.h"
@@ -117,6 +118,7 @@ void add_fleet_command(CLI::App& app) {
   cmd->add_flag("--json", args->json, "one JSON object for scripts instead of a table");
   cmd->add_option("--duration", args->duration_s, "how long to listen, seconds")
       ->default_val(2.0)
+      ->check(cli::positive_seconds())
       ->check(CLI::Range(0.1, 3600.0));
   cmd->add_option("--interface", args->interfaces,
                   "network interface to use (repeatable), e.g. eth0 or lo");

@@ -1,11 +1,30 @@
 // ceilposectl: query the daemon, record, render and localize offline.
 #include <algorithm>
+#include <cerrno>
+#include <csignal>
+#include <cstdio>
+#include <cstring>
 #include <iostream>
 
 #include "ctl/command_registry.h"
 
+namespace {
+
+// What a command printed must have reached stdout: /dev/full, a full disk or
+// a reader that went away (SIGPIPE is ignored, so that shows as EPIPE here)
+// is a failure, never a success with the output lost.
+int with_output_checked(int rc) {
+  std::cout.flush();
+  if (std::fflush(stdout) == 0 && !std::ferror(stdout) && std::cout.good()) return rc;
+  std::fprintf(stderr, "ceilposectl: cannot write to stdout: %s\n", std::strerror(errno));
+  return rc == ceilpose::ctl::kExitOk ? ceilpose::ctl::kExitFailure : rc;
+}
+
+}  // namespace
+
 int main(int argc, char** argv) {
   using namespace ceilpose::ctl;
+  std::signal(SIGPIPE, SIG_IGN);
   CLI::App app{
       "ceilposectl — query the ceilpose daemon, record, render and localize offline.\n"
       "Exit codes: 0 ok, 1 runtime error, 2 usage error, 3 no live daemon or stale pose,\n"
@@ -24,5 +43,5 @@ int main(int argc, char** argv) {
     std::cerr << "ceilposectl: " << e.what() << "\n";
     return kExitFailure;
   }
-  return exit_code();
+  return with_output_checked(exit_code());
 }

@@ -4,12 +4,15 @@
 // re-attaching to the new segment.
 #include <unistd.h>
 
+#include <cerrno>
 #include <chrono>
 #include <cstdio>
+#include <cstring>
 #include <memory>
 #include <string>
 #include <thread>
 
+#include "config/cli_checks.h"
 #include "core/clock.h"
 #include "ctl/command_registry.h"
 #include "ipc/shm/pose_text.h"
@@ -69,7 +72,11 @@ int run_watch(const WatchArgs& args) {
         }
         std::printf("%s\n", pose_table_row(pose, now_ns).c_str());
       }
-      std::fflush(stdout);
+      if (std::fflush(stdout) != 0 || std::ferror(stdout)) {
+        note(std::string("cannot write to stdout: ") + std::strerror(errno) + " after " +
+             std::to_string(printed) + " poses");
+        return kExitFailure;
+      }
       last_seq = pose.seq;
       ++printed;
       reported.clear();
@@ -112,7 +119,8 @@ void add_watch_command(CLI::App& app) {
   cmd->add_option("--shm", args->shm, "shared-memory segment name")->capture_default_str();
   cmd->add_flag("--json", args->json, "JSON lines for machines");
   cmd->add_option("--count", args->count, "stop after N poses (0: until interrupted)")
-      ->capture_default_str();
+      ->capture_default_str()
+      ->check(cli::count());
   cmd->add_option("--stale-ms", args->stale_ms,
                   "a heartbeat older than this is stale"
                   " (default: the daemon's ipc.stale_after_ms, published in the segment)")

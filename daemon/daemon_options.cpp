@@ -1,43 +1,18 @@
 #include "daemon/daemon_options.h"
 
 #include <CLI/CLI.hpp>
-#include <cmath>
 #include <cstdio>
-#include <exception>
 #include <string>
 
 #include "capture/source_spec.h"
+#include "config/cli_checks.h"
 #include "daemon/exit_codes.h"
 
 namespace ceilpose::daemon {
 namespace {
 
-// `--source "$CAM"` with CAM unset must not mean "the default source": on a
-// robot that would be the simulator's poses published as real ones.
-const CLI::Validator kNotEmpty(
-    [](const std::string& value) {
-      return value.empty()
-                 ? std::string("must not be empty (an unset variable in a launch script?)")
-                 : std::string();
-    },
-    "NOT EMPTY");
-
-// A finite number of seconds above 0: nan or 0 would never stop.
-const CLI::Validator kPositiveSeconds(
-    [](const std::string& value) {
-      double s = 0.0;
-      try {
-        size_t used = 0;
-        s = std::stod(value, &used);
-        if (used != value.size()) s = 0.0;
-      } catch (const std::exception&) {
-        s = 0.0;
-      }
-      return std::isfinite(s) && s > 0.0
-                 ? std::string()
-                 : "must be a number of seconds above 0, got '" + value + "'";
-    },
-    "SECONDS > 0");
+const CLI::Validator kNotEmpty = cli::not_empty();
+const CLI::Validator kPositiveSeconds = cli::positive_seconds();
 
 }  // namespace
 

@@ -6,10 +6,10 @@
 
 namespace ceilpose::test {
 
-CommandOutput run_ceilposectl(const std::vector<std::string>& args, int timeout_ms) {
+CommandOutput run_ceilposectl(const std::vector<std::string>& args, int timeout_ms, int stdout_fd) {
   std::vector<std::string> argv{CEILPOSECTL_PATH};
   argv.insert(argv.end(), args.begin(), args.end());
-  CommandOutput result = run_to_end(argv, timeout_ms);
+  CommandOutput result = run_to_end(argv, timeout_ms, stdout_fd);
   if (!result.failure.empty()) ADD_FAILURE() << result.failure;
   return result;
 }

@@ -11,7 +11,9 @@ using CommandOutput = RunOutput;
 
 // Runs ceilposectl with `args` and captures its stdout and stderr. Kills it
 // and fails the current test after `timeout_ms`.
-CommandOutput run_ceilposectl(const std::vector<std::string>& args, int timeout_ms = 60'000);
+// `stdout_fd` >= 0: its stdout is that descriptor instead (see ChildOptions).
+CommandOutput run_ceilposectl(const std::vector<std::string>& args, int timeout_ms = 60'000,
+                              int stdout_fd = -1);
 
 // True when this ceilposectl build has the sub-command.
 bool has_subcommand(const std::string& name);

@@ -254,9 +254,10 @@ bool ChildProcess::reap(bool block) {
   return true;
 }
 
-RunOutput run_to_end(const std::vector<std::string>& argv, int timeout_ms) {
+RunOutput run_to_end(const std::vector<std::string>& argv, int timeout_ms, int stdout_fd) {
   ChildOptions options;
   options.capture_stderr = true;
+  options.stdout_fd = stdout_fd;
   ChildProcess child(argv, options);
   RunOutput result;
   if (!child.started()) {

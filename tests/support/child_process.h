@@ -104,6 +104,6 @@ struct RunOutput {
 
 // Runs `argv` with stdout and stderr captured apart until it ends; kills it
 // after timeout_ms.
-RunOutput run_to_end(const std::vector<std::string>& argv, int timeout_ms);
+RunOutput run_to_end(const std::vector<std::string>& argv, int timeout_ms, int stdout_fd = -1);
 
 }  // namespace ceilpose::test

@@ -1,0 +1,54 @@
+#pragma once
+// Command-line checks ceilposed and ceilposectl share (header-only over
+// CLI11): values a launch script gets wrong by accident must be usage
+// errors, never a default taken in their place or a run that never ends.
+#include <CLI/CLI.hpp>
+#include <cmath>
+#include <exception>
+#include <string>
+
+namespace ceilpose::cli {
+
+// `--source "$CAM"` with CAM unset must not mean "the default": on a robot
+// that would be the simulator's poses published as real ones.
+inline CLI::Validator not_empty() {
+  return CLI::Validator(
+      [](const std::string& value) {
+        return value.empty()
+                   ? std::string("must not be empty (an unset variable in a launch script?)")
+                   : std::string();
+      },
+      "NOT EMPTY");
+}
+
+// A finite number of seconds above 0: nan, inf or 0 would never stop.
+inline CLI::Validator positive_seconds() {
+  return CLI::Validator(
+      [](const std::string& value) {
+        double s = 0.0;
+        try {
+          size_t used = 0;
+          s = std::stod(value, &used);
+          if (used != value.size()) s = 0.0;
+        } catch (const std::exception&) {
+          s = 0.0;
+        }
+        return std::isfinite(s) && s > 0.0
+                   ? std::string()
+                   : "must be a number of seconds above 0, got '" + value + "'";
+      },
+      "SECONDS > 0");
+}
+
+// A whole number of at least 0 (a count where 0 has a documented meaning).
+inline CLI::Validator count() {
+  return CLI::Validator(
+      [](const std::string& value) {
+        const bool digits =
+            !value.empty() && value.find_first_not_of("0123456789") == std::string::npos;
+        return digits ? std::string() : "must be a whole number of at least 0, got '" + value + "'";
+      },
+      "N >= 0");
+}
+
+}  // namespace ceilpose::cli

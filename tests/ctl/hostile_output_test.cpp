@@ -1,0 +1,75 @@
+// Issue 15: output that cannot be written is a failure. Every command that
+// prints into /dev/full or into a pipe whose reader has gone used to exit 0
+// with its output lost.
+#include <fcntl.h>
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <string>
+#include <vector>
+
+#include "tests/ctl/run_ceilposectl.h"
+#include "tests/recording/recording_test_support.h"
+
+namespace ceilpose::test {
+namespace {
+
+constexpr int kExitFailure = 1;
+constexpr int kExitUsage = 2;
+
+class HostileOutput : public ::testing::Test {
+ protected:
+  void SetUp() override { write_recording(dir_, RecordingSpec{}); }
+  std::vector<std::vector<std::string>> printing_commands() const {
+    return {{"inspect", dir_},
+            {"inspect", dir_, "--json"},
+            {"locate", "--replay", dir_},
+            {"evaluate", "--replay", dir_},
+            {"evaluate", "--replay", dir_, "--json"}};
+  }
+  TempDir tmp_;
+  const std::string dir_ = tmp_.sub("rec");
+};
+
+TEST_F(HostileOutput, AFullDeviceIsAFailureThatSaysSo) {
+  for (const auto& args : printing_commands()) {
+    const int full = open("/dev/full", O_WRONLY | O_CLOEXEC);
+    ASSERT_GE(full, 0);
+    const CommandOutput r = run_ceilposectl(args, 60'000, full);
+    close(full);
+    EXPECT_EQ(r.exit_code, kExitFailure) << args[0] << ": " << r.err;
+    EXPECT_NE(r.err.find("ceilposectl: cannot write to stdout: No space left on device"),
+              std::string::npos)
+        << args[0] << ": " << r.err;
+  }
+}
+
+TEST_F(HostileOutput, AReaderThatWentAwayIsAFailureNotASignal) {
+  for (const auto& args : printing_commands()) {
+    int fds[2];
+    ASSERT_EQ(pipe2(fds, O_CLOEXEC), 0);
+    close(fds[0]);
+    const CommandOutput r = run_ceilposectl(args, 60'000, fds[1]);
+    close(fds[1]);
+    EXPECT_EQ(r.exit_code, kExitFailure) << args[0] << " (-1: died of SIGPIPE): " << r.err;
+    EXPECT_NE(r.err.find("ceilposectl: cannot write to stdout: Broken pipe"), std::string::npos)
+        << args[0] << ": " << r.err;
+  }
+}
+
+TEST_F(HostileOutput, CountsAndDurationsThatNeverEndAreUsageErrors) {
+  const CommandOutput watch = run_ceilposectl({"watch", "--count", "-1"});
+  EXPECT_EQ(watch.exit_code, kExitUsage);
+  EXPECT_NE(watch.err.find("--count: must be a whole number of at least 0, got '-1'"),
+            std::string::npos)
+      << watch.err;
+  if (!has_subcommand("fleet")) GTEST_SKIP() << "built without DDS";
+  const CommandOutput fleet = run_ceilposectl({"fleet", "--duration", "nan"});
+  EXPECT_EQ(fleet.exit_code, kExitUsage);
+  EXPECT_NE(fleet.err.find("--duration: must be a number of seconds above 0, got 'nan'"),
+            std::string::npos)
+      << fleet.err;
+}
+
+}  // namespace
+}  // namespace ceilpose::test
