@@ -280,6 +280,30 @@ void check_cross_keys(Reader& r, const ServiceConfig& c) {
             "expected a priority below capture.rt_priority = " + std::to_string(capture_priority) +
                 " (the capture thread must preempt it), found " +
                 std::to_string(c.capture.pipeline_rt_priority));
+  const CameraIntrinsics& k = p.intrinsics;
+  r.require(static_cast<long>(k.width) * k.height <= kMaxImagePixels, "camera.height",
+            "expected at most " + std::to_string(kMaxImagePixels) + " pixels (camera.width x " +
+                "camera.height), found " + std::to_string(k.width) + "x" +
+                std::to_string(k.height));
+  // Each window must be a window: a minimum above its maximum accepts no
+  // rectangle, and the daemon would never have a fix.
+  const DetectorParams& d = p.detector;
+  auto window = [&](double lo, double hi, const char* lo_key, const char* hi_key) {
+    r.require(lo <= hi, std::string("detector.") + lo_key,
+              std::string("expected at most detector.") + hi_key + " = " + number_text(hi) +
+                  ", found " + number_text(lo));
+  };
+  window(d.aspect_min, d.aspect_max, "aspect_min", "aspect_max");
+  window(d.fill_min, d.fill_max, "fill_min", "fill_max");
+  window(d.area_min_ratio, d.area_max_ratio, "area_min_ratio", "area_max_ratio");
+  // A marker (red and green side by side, East) must fit its grid cell.
+  r.require(
+      2.0 * p.layout.rect_width_m < p.layout.grid_m && p.layout.rect_height_m < p.layout.grid_m,
+      "ceiling.rect_width_m",
+      "expected a marker (2 x ceiling.rect_width_m wide, ceiling.rect_height_m tall) "
+      "inside its grid cell (ceiling.grid_m = " +
+          number_text(p.layout.grid_m) + "), found " + number_text(p.layout.rect_width_m) + " x " +
+          number_text(p.layout.rect_height_m) + " m rectangles");
   const double marker_n_m = (p.layout.bits - 1) * p.layout.slot_pitch_m;
   r.require(marker_n_m < p.layout.rect_height_m, "ceiling.slot_pitch_m",
             "expected all " + std::to_string(p.layout.bits) +

@@ -11,6 +11,8 @@
 
 #include "capture/source_spec.h"
 #include "config/service_config.h"
+#include "core/ros_name.h"
+#include "ipc/shm/shm_common.h"
 #include "pipeline/marker_observation.h"
 
 namespace ceilpose::config_detail {
@@ -27,10 +29,24 @@ inline const char* check_source(const std::string& s) {
 }
 
 inline const char* check_shm_name(const std::string& s) {
-  // POSIX: one leading slash, no other, at most NAME_MAX characters.
-  if (s.size() >= 2 && s.size() <= 255 && s[0] == '/' && s.find('/', 1) == std::string::npos)
-    return nullptr;
-  return "a shared-memory name: '/' followed by 1-254 characters without '/'";
+  if (shm::valid_shm_name(s)) return nullptr;
+  return "a shared-memory name: '/' followed by 1-249 printable characters without '/' or space "
+         "(not '/.' or '/..')";
+}
+
+// Empty: the host name, made a ROS name (daemon/service.cpp).
+inline const char* check_robot_name(const std::string& s) {
+  if (s.empty() || is_valid_ros_name(s)) return nullptr;
+  return "a ROS 2 name token: a letter or '_', then letters, digits and single '_' (no '-' or "
+         "'.')";
+}
+
+// Looked up here, so that a group missing on this machine is a
+// configuration error (exit 3), not a failure at start-up that systemd
+// restarts forever.
+inline const char* check_group(const std::string& s) {
+  if (s.empty() || shm::lookup_group(s, "ipc", nullptr)) return nullptr;
+  return "an existing group (see getent group), or empty for the daemon's own";
 }
 
 inline const char* check_any_text(const std::string&) { return nullptr; }
@@ -56,8 +72,8 @@ void describe(V& v, ServiceConfig& c) {
   PipelineConfig& p = c.pipeline;
   v.section("camera", [&] {
     CameraIntrinsics& k = p.intrinsics;
-    v.field("width", k.width, 1, 16384);
-    v.field("height", k.height, 1, 16384);
+    v.field("width", k.width, 1, kMaxImageSidePx);
+    v.field("height", k.height, 1, kMaxImageSidePx);
     v.field("fx", k.fx, 1.0, 1e6);
     v.field("fy", k.fy, 1.0, 1e6);
     v.field("cx", k.cx, -1e5, 1e5);
@@ -209,7 +225,7 @@ void describe(V& v, ServiceConfig& c) {
   });
   v.section("ipc", [&] {
     v.text("shm_name", c.ipc.name, &check_shm_name);
-    v.text("group", c.ipc.group, &check_any_text);
+    v.text("group", c.ipc.group, &check_group);
     v.field("stale_after_ms", c.ipc.stale_after_ms, 1, 600'000);
   });
   v.section("dds", [&] {
@@ -218,7 +234,7 @@ void describe(V& v, ServiceConfig& c) {
     v.field("enabled", d.enabled);
     // RTPS port arithmetic leaves room for domains 0..230 only (Cyclone's limit).
     v.field("domain_id", o.domain.domain_id, 0u, 230u);
-    v.text("robot_name", o.robot, &check_no_space);
+    v.text("robot_name", o.robot, &check_robot_name);
     v.choice("reliability", o.reliability,
              Choices<DdsReliability>{{"reliable", DdsReliability::kReliable},
                                      {"best_effort", DdsReliability::kBestEffort}});

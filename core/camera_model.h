@@ -27,6 +27,13 @@ struct CameraIntrinsics {
   bool operator==(const CameraIntrinsics&) const = default;
 };
 
+// The largest image ceilpose takes (configuration and recordings alike):
+// 8192 px a side and 32 Mpx, a 12 MP sensor with room to spare. The
+// pipeline's buffers are ~20 bytes a pixel; a recording.yaml saying
+// 100000x100000 must be refused, not allocated.
+inline constexpr int kMaxImageSidePx = 8192;
+inline constexpr long kMaxImagePixels = 32L * 1024 * 1024;
+
 // SPEC §3: when pixel row v_px (fractional) was exposed, seconds after the
 // centre row; 0 for a global shutter.
 inline double row_time_s(const CameraIntrinsics& k, double v_px) {

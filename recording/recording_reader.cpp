@@ -17,6 +17,7 @@
 #include <sstream>
 #include <string_view>
 
+#include "core/text_file.h"
 #include "recording/frame_file.h"
 #include "recording/recording_format.h"
 
@@ -95,12 +96,14 @@ Result<double> yaml_camera_number(const YAML::Node& camera, const char* key,
 
 Result<RecordingCamera> parse_yaml(const std::string& path) {
   YAML::Node root;
+  struct stat st {};
+  if (::stat(path.c_str(), &st) != 0 && errno == ENOENT)
+    return make_error(path + ": missing (not a recording directory?)");
+  // A regular file of a sane size: not a directory, a FIFO or /dev/zero.
+  auto text = read_text_file(path, "recording.yaml", size_t{1} << 20);
+  if (!text) return text.error();
   try {
-    root = YAML::LoadFile(path);
-  } catch (const YAML::BadFile&) {
-    const bool exists = std::ifstream(path).good();
-    return make_error(path +
-                      (exists ? ": cannot be read" : ": missing (not a recording directory?)"));
+    root = YAML::Load(*text);
   } catch (const YAML::ParserException& e) {
     return make_error(path + ":" + std::to_string(e.mark.line + 1) + ":" +
                       std::to_string(e.mark.column + 1) + ": YAML syntax error: " + e.msg);
@@ -137,11 +140,18 @@ Result<RecordingCamera> parse_yaml(const std::string& path) {
   for (auto [key, dst] : {std::pair{"width", &k.width}, std::pair{"height", &k.height}}) {
     auto v = yaml_scalar<int>(cam, "camera", key, path, "a positive integer");
     if (!v) return v.error();
-    if (*v <= 0) {
+    if (*v <= 0 || *v > kMaxImageSidePx) {
       return make_error(path + ":" + std::to_string(line_of(cam[key])) + ": key 'camera." + key +
-                        "' must be a positive integer, got " + std::to_string(*v));
+                        "' must be 1 to " + std::to_string(kMaxImageSidePx) + " pixels, got " +
+                        std::to_string(*v));
     }
     *dst = *v;
+  }
+  if (static_cast<long>(k.width) * k.height > kMaxImagePixels) {
+    return make_error(path + ":" + std::to_string(line_of(cam["height"])) +
+                      ": camera.width x camera.height must be at most " +
+                      std::to_string(kMaxImagePixels) + " pixels, got " + std::to_string(k.width) +
+                      "x" + std::to_string(k.height));
   }
   for (auto [key, dst, positive] :
        {std::tuple{"fx", &k.fx, true}, std::tuple{"fy", &k.fy, true},
@@ -328,6 +338,15 @@ Result<RecordingRow> parse_row(const std::vector<std::string>& fields, const Col
   if (row.file.front() == '/') {
     return make_error(where + ": file " + quoted(row.file) +
                       " must be relative to the recording directory");
+  }
+  // Nor may it climb out of it.
+  for (size_t start = 0; start <= row.file.size();) {
+    const size_t end = std::min(row.file.find('/', start), row.file.size());
+    if (row.file.compare(start, end - start, "..") == 0) {
+      return make_error(where + ": file " + quoted(row.file) +
+                        " must stay inside the recording directory (no '..')");
+    }
+    start = end + 1;
   }
   if (!ground_truth_columns) return row;
   const std::string& gx = fields[cols.gt_x];

@@ -8,9 +8,6 @@ namespace {
 // Cyclone 0.10 refuses domain ids above 230 (the port mapping would overflow).
 constexpr uint32_t kMaxDomainId = 230;
 
-bool is_alpha(char c) { return std::isalpha(static_cast<unsigned char>(c)) != 0; }
-bool is_alnum(char c) { return std::isalnum(static_cast<unsigned char>(c)) != 0; }
-
 // Interface names and peer addresses are pasted into XML attributes; rather
 // than escape, refuse what no interface name or address contains.
 bool is_plain_xml_value(std::string_view value) {
@@ -25,29 +22,6 @@ bool is_plain_xml_value(std::string_view value) {
 }
 
 }  // namespace
-
-bool is_valid_ros_name(std::string_view name) {
-  if (name.empty() || !(is_alpha(name[0]) || name[0] == '_')) return false;
-  for (size_t k = 0; k < name.size(); ++k) {
-    const char c = name[k];
-    if (!(is_alnum(c) || c == '_')) return false;
-    if (c == '_' && k + 1 < name.size() && name[k + 1] == '_') return false;
-  }
-  return true;
-}
-
-std::string to_ros_name(std::string_view text) {
-  std::string out;
-  for (char c : text) {
-    const char mapped = is_alnum(c) ? c : '_';
-    if (mapped == '_' && !out.empty() && out.back() == '_') continue;
-    out.push_back(mapped);
-  }
-  if (!out.empty() && std::isdigit(static_cast<unsigned char>(out[0])) != 0) {
-    out.insert(out.begin(), 'r');
-  }
-  return out;
-}
 
 std::string pose_topic_name(std::string_view robot) { return "rt/" + std::string(robot) + "/pose"; }
 

@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "core/result.h"
+#include "core/ros_name.h"
 
 namespace ceilpose {
 
@@ -40,14 +41,7 @@ struct DdsOptions {
   int32_t history_depth = 10;  // keep-last depth of the writers, >= 1
 };
 
-// A legal single-token ROS 2 name (rmw_validate_namespace's rules for one
-// token): [A-Za-z_][A-Za-z0-9_]*, without repeated underscores.
-bool is_valid_ros_name(std::string_view name);
-
-// Replaces every character a ROS name token may not hold ('-', '.', ...) with
-// '_' (collapsing runs) and prefixes 'r' to a leading digit: host names such as "robot-7" then
-// become usable robot names ("robot_7"). Empty input yields empty output.
-std::string to_ros_name(std::string_view text);
+// is_valid_ros_name() and to_ros_name(): core/ros_name.h.
 
 std::string pose_topic_name(std::string_view robot);    // "rt/<robot>/pose"
 std::string status_topic_name(std::string_view robot);  // "rt/<robot>/ceilpose_status"

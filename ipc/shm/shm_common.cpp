@@ -1,5 +1,6 @@
 #include "ipc/shm/shm_common.h"
 
+#include <grp.h>
 #include <linux/futex.h>
 #include <signal.h>
 #include <sys/mman.h>
@@ -11,6 +12,7 @@
 #include <cstdio>
 #include <cstring>
 #include <ctime>
+#include <vector>
 
 namespace ceilpose::shm {
 
@@ -20,9 +22,39 @@ Error fail(ShmErrc* out, ShmErrc code, std::string message) {
 }
 
 bool valid_shm_name(const std::string& name) {
-  // NAME_MAX (255) minus room for the "-wake" companion suffix.
+  // NAME_MAX (255) minus room for the "-wake" companion suffix; "/." and
+  // "/.." are /dev/shm's directories, and a space or control character is a
+  // quoting accident, not a name.
   if (name.size() < 2 || name.size() > 250 || name[0] != '/') return false;
-  return name.find('/', 1) == std::string::npos;
+  if (name == "/." || name == "/..") return false;
+  for (size_t k = 1; k < name.size(); ++k) {
+    const auto c = static_cast<unsigned char>(name[k]);
+    if (c == '/' || c <= ' ' || c == 0x7f) return false;
+  }
+  return true;
+}
+
+Result<gid_t> lookup_group(const std::string& group, const std::string& segment, ShmErrc* code) {
+  if (group.empty()) return ::getegid();
+  std::vector<char> buffer(16384);
+  struct group entry {};
+  struct group* found = nullptr;
+  int rc = 0;
+  while ((rc = ::getgrnam_r(group.c_str(), &entry, buffer.data(), buffer.size(), &found)) ==
+             ERANGE &&
+         buffer.size() < (1u << 20)) {
+    buffer.resize(buffer.size() * 4);
+  }
+  if (rc != 0) {
+    return fail(code, ShmErrc::kSystem,
+                "cannot look up group '" + group + "' for shm segment " + segment + ": " +
+                    shm::errno_text(rc));
+  }
+  if (found == nullptr) {
+    return fail(code, ShmErrc::kNoGroup,
+                "group '" + group + "' for shm segment " + segment + " does not exist");
+  }
+  return found->gr_gid;
 }
 
 std::string wake_segment_name(const std::string& name) { return name + "-wake"; }

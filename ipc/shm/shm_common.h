@@ -2,6 +2,8 @@
 // Pieces shared by the writer and the reader: typed errors, RAII owners of the
 // descriptor and the mapping, the futex calls. Thin system wrappers return
 // -errno and never log; callers turn them into messages with context.
+#include <sys/types.h>
+
 #include <cstddef>
 #include <cstdint>
 #include <string>
@@ -63,6 +65,10 @@ bool process_exists(int pid);
 std::string mode_text(unsigned mode);
 // Describes errno values in messages: "Permission denied (EACCES)".
 std::string errno_text(int error);
+
+// The group id of `group` (the process's own group when empty); the error
+// names the group and the segment it was for.
+Result<gid_t> lookup_group(const std::string& group, const std::string& segment, ShmErrc* code);
 // Classifies an errno from shm_open/mmap into a typed error.
 ShmErrc errc_from_errno(int error);
 

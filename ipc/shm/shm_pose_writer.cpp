@@ -36,29 +36,6 @@ constexpr mode_t kWakeMode = 0660;
 // Creation races with another creator at most a couple of times.
 constexpr int kCreateAttempts = 3;
 
-Result<gid_t> lookup_group(const std::string& group, const std::string& segment, ShmErrc* code) {
-  if (group.empty()) return ::getegid();
-  std::vector<char> buffer(16384);
-  struct group entry {};
-  struct group* found = nullptr;
-  int rc = 0;
-  while ((rc = ::getgrnam_r(group.c_str(), &entry, buffer.data(), buffer.size(), &found)) ==
-             ERANGE &&
-         buffer.size() < (1u << 20)) {
-    buffer.resize(buffer.size() * 4);
-  }
-  if (rc != 0) {
-    return fail(code, ShmErrc::kSystem,
-                "cannot look up group '" + group + "' for shm segment " + segment + ": " +
-                    shm::errno_text(rc));
-  }
-  if (found == nullptr) {
-    return fail(code, ShmErrc::kNoGroup,
-                "group '" + group + "' for shm segment " + segment + " does not exist");
-  }
-  return found->gr_gid;
-}
-
 // Reads the writer pid of an existing segment for the "live writer" message;
 // 0 when the segment is not (yet) a valid one.
 int existing_writer_pid(int fd) {
@@ -322,7 +299,7 @@ Result<ShmPoseWriter> ShmPoseWriter::create(const ShmOptions& options, ShmErrc* 
   if (code != nullptr) *code = ShmErrc::kOk;
   const std::string& name = options.name;
   if (auto ok = check_options(options, code); !ok) return ok.error();
-  auto gid = lookup_group(options.group, name, code);
+  auto gid = shm::lookup_group(options.group, name, code);
   if (!gid) return gid.error();
   auto fd = claim_name(name, code);
   if (!fd) return fd.error();

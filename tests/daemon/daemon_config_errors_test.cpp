@@ -19,6 +19,8 @@ class DaemonBadConfig : public ::testing::TestWithParam<BadConfig> {
   std::string path() {
     const BadConfig& c = GetParam();
     if (c.yaml == nullptr) return ::testing::TempDir() + "does-not-exist.yaml";
+    if (std::string(c.name) == "ConfigIsADirectory") return ::testing::TempDir();
+    if (std::string(c.name) == "ConfigIsNotARegularFile") return "/dev/zero";
     return write_temp_file("bad.yaml", c.yaml);
   }
 };
@@ -42,14 +44,41 @@ TEST_P(DaemonBadConfig, StartingRefusesBeforeCreatingAnything) {
 
 INSTANTIATE_TEST_SUITE_P(
     Kinds, DaemonBadConfig,
-    ::testing::Values(BadConfig{"SyntaxError", "camera:\n  fx: [530\n", "YAML syntax error"},
-                      BadConfig{"UnknownKey", "camera:\n  fx: 530\n  fz: 1\n",
-                                ":3: unknown key 'camera.fz'"},
-                      BadConfig{"WrongType", "capture:\n  fps: fast\n",
-                                ":2: capture.fps: expected a number, found 'fast'"},
-                      BadConfig{"OutOfRange", "dds:\n  domain_id: 999\n",
-                                ":2: dds.domain_id: expected a value in [0, 230], found '999'"},
-                      BadConfig{"MissingFile", nullptr, "cannot read configuration file"}),
+    ::testing::Values(
+        BadConfig{"SyntaxError", "camera:\n  fx: [530\n", "YAML syntax error"},
+        BadConfig{"UnknownKey", "camera:\n  fx: 530\n  fz: 1\n", ":3: unknown key 'camera.fz'"},
+        BadConfig{"WrongType", "capture:\n  fps: fast\n",
+                  ":2: capture.fps: expected a number, found 'fast'"},
+        BadConfig{"OutOfRange", "dds:\n  domain_id: 999\n",
+                  ":2: dds.domain_id: expected a value in [0, 230], found '999'"},
+        BadConfig{"MissingFile", nullptr, "cannot read configuration file"},
+        // Issue 15: windows that accept nothing, a marker larger
+        // than its cell, and what used to fail only at start-up.
+        BadConfig{"AspectWindowInverted", "detector:\n  aspect_min: 0.9\n  aspect_max: 0.5\n",
+                  "detector.aspect_min: expected at most detector.aspect_max = 0.5, "
+                  "found 0.9"},
+        BadConfig{"FillWindowInverted", "detector:\n  fill_min: 1.5\n  fill_max: 1\n",
+                  "detector.fill_min: expected at most detector.fill_max = 1"},
+        BadConfig{"AreaWindowInverted", "detector:\n  area_min_ratio: 5\n  area_max_ratio: 2\n",
+                  "detector.area_min_ratio: expected at most "
+                  "detector.area_max_ratio = 2"},
+        BadConfig{"MarkerLargerThanItsCell", "ceiling:\n  rect_width_m: 5\n",
+                  "ceiling.rect_width_m: expected a marker"},
+        BadConfig{"RobotNameNotARosName", "dds:\n  robot_name: my-robot\n",
+                  "dds.robot_name: expected a ROS 2 name token"},
+        BadConfig{"GroupThatDoesNotExist", "ipc:\n  group: nosuchgroup\n",
+                  "ipc.group: expected an existing group"},
+        BadConfig{"ShmNameIsADirectory", "ipc:\n  shm_name: /..\n",
+                  "ipc.shm_name: expected a shared-memory name"},
+        BadConfig{"ShmNameTooLong",
+                  "ipc:\n  shm_name: /"
+                  "aaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaa"
+                  "aaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaa"
+                  "aaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaa"
+                  "aaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaa\n",
+                  "ipc.shm_name: expected a shared-memory name"},
+        BadConfig{"ConfigIsADirectory", "", "it is a directory"},
+        BadConfig{"ConfigIsNotARegularFile", "", "not a regular file"}),
     [](const auto& info) { return std::string(info.param.name); });
 
 TEST(DaemonCommandLine, ABadMapStopsTheDaemonNamingTheMapAndTheEntry) {

@@ -200,6 +200,30 @@ std::vector<MalformedCase> make_cases() {
                png,
                [=](const std::string& d) { replace_line(yaml(d), 11, "  readout_ms: -3"); },
                {"recording.yaml:11", "'camera.readout_ms'", "0 to 1000 ms"}});
+  // Issue 15: 100000x100000 aborted the daemon on bad_alloc.
+  c.push_back({"HugeWidth",
+               png,
+               [=](const std::string& d) { replace_line(yaml(d), 4, "  width: 100000"); },
+               {"recording.yaml:4", "'camera.width' must be 1 to 8192 pixels, got 100000"}});
+  c.push_back({"TooManyPixels",
+               png,
+               [=](const std::string& d) {
+                 replace_line(yaml(d), 4, "  width: 8000");
+                 replace_line(yaml(d), 5, "  height: 8000");
+               },
+               {"recording.yaml:5", "must be at most 33554432 pixels, got 8000x8000"}});
+  c.push_back({"RecordingYamlIsADirectory",
+               png,
+               [=](const std::string& d) {
+                 fs::remove(yaml(d));
+                 fs::create_directory(yaml(d));
+               },
+               {"recording.yaml", "it is a directory"}});
+  c.push_back(
+      {"FramePathClimbsOut",
+       png,
+       [=](const std::string& d) { replace_line(csv(d), 2, "0,1000000000,../outside.png,0,0,0"); },
+       {"frames.csv:2", "'../outside.png' must stay inside the recording directory"}});
   c.push_back({"MissingFramesCsv",
                png,
                [=](const std::string& d) { fs::remove(csv(d)); },
