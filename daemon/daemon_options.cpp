@@ -23,7 +23,8 @@ bool parse_command_line(int argc, char** argv, DaemonOptions* options, int* exit
       "Command-line options override the configuration file; defaults are SPEC.md's.\n"
       "Signals: SIGTERM/SIGINT stop cleanly, SIGHUP reloads the configuration file.\n"
       "Exit codes: 0 ok, 1 runtime failure, 2 usage error, 3 bad configuration,\n"
-      "4 frame source failure."};
+      "4 frame source failure, 5 shared-memory name held (another ceilposed, or another\n"
+      "user's file in /dev/shm)."};
   app.set_version_flag("--version", "ceilposed 0.1.0");
 
   std::string source, robot, shm, log_level;

@@ -10,6 +10,9 @@ enum ExitCode : int {
   kExitUsage = 2,          // bad command line
   kExitBadConfig = 3,      // configuration file missing, malformed or out of range
   kExitSourceFailure = 4,  // the frame source could not be opened or failed for good
+  // The shared-memory name is held: another live ceilposed, or another
+  // user's file, link or directory in /dev/shm. Retrying cannot help.
+  kExitShmNameTaken = 5,
 };
 
 }  // namespace ceilpose::daemon

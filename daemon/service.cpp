@@ -173,10 +173,12 @@ int Service::start_capture() {
 }
 
 int Service::start_shared_memory() {
-  auto shm = ShmPoseWriter::create(config_.ipc);
+  shm::ShmErrc code = shm::ShmErrc::kOk;
+  auto shm = ShmPoseWriter::create(config_.ipc, &code);
   if (!shm) {
     spdlog::error("shared memory: {}", shm.error().message);
-    return kExitRuntime;
+    return code == shm::ShmErrc::kNameTaken || code == shm::ShmErrc::kLiveWriter ? kExitShmNameTaken
+                                                                                 : kExitRuntime;
   }
   shm_.emplace(std::move(shm).value());
   shm_sink_.emplace(&*shm_, config_.watchdog.status_interval_ms);
@@ -241,6 +243,7 @@ void Service::loop() {
   int64_t next_print = now;
   uint64_t printed_frame = 0;
   PosePrinter printer(start_ns_);
+  uint64_t header_repairs = 0;
   bool stalled_reported = false;
 
   for (;;) {
@@ -285,6 +288,13 @@ void Service::loop() {
     }
     if (now >= next_status) {
       next_status = now + status_period_ns;
+      if (shm_ && shm_->header_repairs() != header_repairs) {
+        header_repairs = shm_->header_repairs();
+        spdlog::error(
+            "shared memory: the header of {} was overwritten by another process (its owner's "
+            "user or root); restored, {} times so far",
+            shm_->name(), header_repairs);
+      }
       notifier_.status(status_line(worker_->latest(), worker_->latency()));
     }
     if (now >= next_problems) {

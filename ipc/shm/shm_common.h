@@ -27,6 +27,10 @@ enum class ShmErrc : int {
   kNoMemory = -9,
   kLiveWriter = -15,
   kNoGroup = -16,
+  // The writer's own (no C client sees it): the name is held by something
+  // the daemon must not and cannot replace: another user's file, a symbolic
+  // link or a directory in /dev/shm.
+  kNameTaken = -19,
 };
 
 // Stores `code` in *out (if given) and returns the error with `message`.

@@ -111,6 +111,11 @@ struct alignas(64) SegmentHeader {
   // The writer's ipc.stale_after_ms: what readers call stale unless told
   // otherwise. Written once, before `magic`.
   uint32_t stale_after_ms;
+  // The -wake segment's inode, written once before `magic`: readers know
+  // their writer's -wake by it, not by its magic and generation, which any
+  // reader may overwrite (it is read-write for them). 0 from writers before
+  // it existed (then the magic is checked). In what was padding: ABI 3.
+  uint64_t wake_inode;
 };
 
 struct Segment {
@@ -138,6 +143,7 @@ static_assert(offsetof(SegmentHeader, state) == 64, "layout of docs/ipc.md");
 static_assert(offsetof(SegmentHeader, wake_seq) == 68, "layout of docs/ipc.md");
 static_assert(offsetof(SegmentHeader, heartbeat_mono_ns) == 72, "layout of docs/ipc.md");
 static_assert(offsetof(SegmentHeader, latest_seq) == 80, "layout of docs/ipc.md");
+static_assert(offsetof(SegmentHeader, wake_inode) == 96, "layout of docs/ipc.md");
 static_assert(offsetof(SegmentHeader, stale_after_ms) == 88, "layout of docs/ipc.md");
 static_assert(offsetof(Segment, ring) == 1344, "layout of docs/ipc.md");
 static_assert(sizeof(SeqlockSlot<PoseRecord>) == 896, "layout of docs/ipc.md");

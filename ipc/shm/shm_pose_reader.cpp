@@ -218,10 +218,12 @@ Result<void> check_header(const Segment& seg, size_t size_bytes, const std::stri
   return {};
 }
 
-// Opens and maps the "-wake" companion read-write; it must belong to the
-// pose segment's writer generation.
+// Opens and maps the "-wake" companion read-write; it must be the one the
+// pose segment's writer made: the inode its header names (a group reader
+// writing garbage into -wake then locks nobody out), or for writers that do
+// not record it, the writer's magic and generation.
 Result<OpenedSegment> open_wake_segment(const std::string& name, uint64_t generation,
-                                        ShmErrc* code) {
+                                        uint64_t wake_inode, ShmErrc* code) {
   const std::string wake_name = shm::wake_segment_name(name);
   OpenedSegment out;
   out.fd = UniqueFd(::shm_open(wake_name.c_str(), O_RDWR | O_CLOEXEC, 0));
@@ -250,8 +252,11 @@ Result<OpenedSegment> open_wake_segment(const std::string& name, uint64_t genera
                 "cannot map shm segment " + wake_name + ": " + shm::errno_text(map_error));
   }
   const auto* wake = static_cast<const WakeSegment*>(out.mapping.get());
-  if (wake->magic.load(std::memory_order_acquire) != shm::kWakeMagic ||
-      wake->generation != generation) {
+  const bool belongs = wake_inode != 0
+                           ? static_cast<uint64_t>(out.st.st_ino) == wake_inode
+                           : wake->magic.load(std::memory_order_acquire) == shm::kWakeMagic &&
+                                 wake->generation == generation;
+  if (!belongs) {
     return fail(code, ShmErrc::kNotReady,
                 "shm segment " + wake_name + " does not belong to " + name +
                     " (its writer is starting or replacing it)");
@@ -273,7 +278,7 @@ Result<ShmPoseReader> ShmPoseReader::open(const std::string& name, ShmErrc* code
   const auto* seg = static_cast<const Segment*>(pose->mapping.get());
   if (auto ok = check_header(*seg, static_cast<size_t>(pose->st.st_size), name, code); !ok)
     return ok.error();
-  auto wake = open_wake_segment(name, seg->header.generation, code);
+  auto wake = open_wake_segment(name, seg->header.generation, seg->header.wake_inode, code);
   if (!wake) return wake.error();
 
   auto impl = std::make_unique<Impl>();

@@ -3,6 +3,7 @@
 #include <fcntl.h>
 #include <grp.h>
 #include <pthread.h>
+#include <pwd.h>
 #include <sys/file.h>
 #include <sys/mman.h>
 #include <sys/stat.h>
@@ -101,6 +102,12 @@ struct ShmPoseWriter::Impl {
   bool running = false;
   bool stopped = false;
 
+  // What the header's identity was made as, to tell when something else
+  // (the owner's user or root: readers map it read-only) wrote over it.
+  shm::SegmentHeader identity{};
+  std::atomic<uint64_t> header_repairs{0};
+  std::mutex identity_mutex;  // try-locked: one checker at a time, nobody waits
+
   std::mutex heartbeat_mutex;
   std::condition_variable heartbeat_cv;
   bool heartbeat_stop = false;
@@ -112,6 +119,56 @@ struct ShmPoseWriter::Impl {
   }
 
   void beat() { seg->header.heartbeat_mono_ns.store(monotonic_ns(), std::memory_order_release); }
+
+  void remember_identity() {
+    const shm::SegmentHeader& h = seg->header;
+    identity.magic.store(h.magic.load(std::memory_order_relaxed), std::memory_order_relaxed);
+    identity.abi_version = h.abi_version;
+    identity.header_size = h.header_size;
+    identity.segment_size = h.segment_size;
+    identity.ring_length = h.ring_length;
+    identity.pose_size = h.pose_size;
+    identity.status_size = h.status_size;
+    identity.writer_pid = h.writer_pid;
+    identity.generation = h.generation;
+    identity.start_mono_ns = h.start_mono_ns;
+    identity.start_real_ns = h.start_real_ns;
+    identity.stale_after_ms = h.stale_after_ms;
+    identity.wake_inode = h.wake_inode;
+  }
+
+  // Puts the identity back if it was overwritten (new readers would say
+  // "bad magic" forever); the magic last, as at creation.
+  void check_identity() {
+    std::unique_lock<std::mutex> lock(identity_mutex, std::try_to_lock);
+    if (!lock.owns_lock()) return;
+    shm::SegmentHeader& h = seg->header;
+    const shm::SegmentHeader& i = identity;
+    const bool intact =
+        h.magic.load(std::memory_order_acquire) == i.magic.load(std::memory_order_relaxed) &&
+        h.abi_version == i.abi_version && h.header_size == i.header_size &&
+        h.segment_size == i.segment_size && h.ring_length == i.ring_length &&
+        h.pose_size == i.pose_size && h.status_size == i.status_size &&
+        h.writer_pid == i.writer_pid && h.generation == i.generation &&
+        h.start_mono_ns == i.start_mono_ns && h.start_real_ns == i.start_real_ns &&
+        h.stale_after_ms == i.stale_after_ms && h.wake_inode == i.wake_inode;
+    if (intact) return;
+    h.magic.store(0, std::memory_order_release);
+    h.abi_version = i.abi_version;
+    h.header_size = i.header_size;
+    h.segment_size = i.segment_size;
+    h.ring_length = i.ring_length;
+    h.pose_size = i.pose_size;
+    h.status_size = i.status_size;
+    h.writer_pid = i.writer_pid;
+    h.generation = i.generation;
+    h.start_mono_ns = i.start_mono_ns;
+    h.start_real_ns = i.start_real_ns;
+    h.stale_after_ms = i.stale_after_ms;
+    h.wake_inode = i.wake_inode;
+    h.magic.store(i.magic.load(std::memory_order_relaxed), std::memory_order_release);
+    header_repairs.fetch_add(1, std::memory_order_relaxed);
+  }
 
   void wake_readers(bool always) {
     wake_seq += 1;
@@ -141,6 +198,7 @@ struct ShmPoseWriter::Impl {
       std::unique_lock<std::mutex> lock(heartbeat_mutex);
       while (!heartbeat_cv.wait_for(lock, std::chrono::milliseconds(period_ms),
                                     [this] { return heartbeat_stop; })) {
+        check_identity();
         beat();
       }
     });
@@ -174,6 +232,29 @@ Result<void> check_options(const ShmOptions& options, ShmErrc* code) {
   return {};
 }
 
+// What sits at /dev/shm/<name> when it is not a segment this daemon's user
+// may replace, for the error message; empty when it is one (a regular file
+// of ours) or nothing is there. /dev/shm is world-writable and sticky: any
+// local user can put a file, a link or a directory at our name, and only its
+// owner or root can remove it.
+std::string squatter(const std::string& name) {
+  const std::string path = "/dev/shm" + name;
+  struct stat st {};
+  if (::lstat(path.c_str(), &st) != 0) return {};
+  const char* kind = S_ISLNK(st.st_mode)   ? "a symbolic link"
+                     : S_ISDIR(st.st_mode) ? "a directory"
+                     : S_ISREG(st.st_mode) ? "a file"
+                                           : "a special file";
+  if (S_ISREG(st.st_mode) && st.st_uid == ::geteuid()) return {};
+  const struct passwd* pw = ::getpwuid(st.st_uid);
+  return path + " is " + kind + " owned by uid " + std::to_string(st.st_uid) +
+         (pw != nullptr ? " (" + std::string(pw->pw_name) + ")" : std::string()) +
+         (S_ISREG(st.st_mode)
+              ? ", not by this daemon's user (uid " + std::to_string(::geteuid()) + ")"
+              : std::string(", not a shared-memory segment")) +
+         ": remove it (as its owner or root) or choose another ipc.shm_name";
+}
+
 // Creates `name` exclusively and locks it. An existing segment is replaced
 // only when no live writer holds its lock (flock is dropped by the kernel when
 // the owner dies, whatever the pid namespace).
@@ -188,6 +269,8 @@ Result<UniqueFd> claim_name(const std::string& name, ShmErrc* code) {
                   "cannot create shm segment " + name + " (mode " + shm::mode_text(kSegmentMode) +
                       "): " + shm::errno_text(e));
     }
+    if (const std::string taken = squatter(name); !taken.empty())
+      return fail(code, ShmErrc::kNameTaken, "cannot create shm segment " + name + ": " + taken);
     UniqueFd old(::shm_open(name.c_str(), O_RDWR | O_CLOEXEC, 0));
     if (!old.valid()) {
       const int oe = errno;
@@ -252,6 +335,8 @@ Result<Mapping> size_and_map(int fd, const std::string& name, size_t size_bytes,
 Result<void> create_wake_segment(const std::string& name, gid_t gid, uint64_t generation,
                                  UniqueFd* fd_out, Mapping* mapping_out, ShmErrc* code) {
   const std::string wake_name = shm::wake_segment_name(name);
+  if (const std::string taken = squatter(wake_name); !taken.empty())
+    return fail(code, ShmErrc::kNameTaken, "cannot create shm segment " + wake_name + ": " + taken);
   ::shm_unlink(wake_name.c_str());  // a stale one, if any; ENOENT is normal
   UniqueFd fd(::shm_open(wake_name.c_str(), O_RDWR | O_CREAT | O_EXCL | O_CLOEXEC, kWakeMode));
   if (!fd.valid()) {
@@ -273,7 +358,8 @@ Result<void> create_wake_segment(const std::string& name, gid_t gid, uint64_t ge
 
 // Fills the pose segment's header; `magic` last, so a reader that sees it
 // sees the rest.
-Segment* init_pose_segment(void* memory, const ShmOptions& options, uint64_t generation) {
+Segment* init_pose_segment(void* memory, const ShmOptions& options, uint64_t generation,
+                           uint64_t wake_inode) {
   auto* seg = new (memory) Segment();
   auto& h = seg->header;
   h.abi_version = shm::kAbiVersion;
@@ -289,6 +375,7 @@ Segment* init_pose_segment(void* memory, const ShmOptions& options, uint64_t gen
   h.state.store(static_cast<uint32_t>(WriterState::kStarting), std::memory_order_relaxed);
   h.heartbeat_mono_ns.store(h.start_mono_ns, std::memory_order_relaxed);
   h.stale_after_ms = static_cast<uint32_t>(std::max(1, options.stale_after_ms));
+  h.wake_inode = wake_inode;
   h.magic.store(shm::kMagic, std::memory_order_release);
   return seg;
 }
@@ -326,7 +413,15 @@ Result<ShmPoseWriter> ShmPoseWriter::create(const ShmOptions& options, ShmErrc* 
   auto mapping = size_and_map(fd->get(), name, sizeof(Segment), code);
   if (!mapping) return mapping.error();
 
-  impl->seg = init_pose_segment(mapping->get(), options, generation);
+  struct stat wake_st {};
+  if (::fstat(impl->wake_fd.get(), &wake_st) != 0) {
+    const int e = errno;
+    return fail(
+        code, shm::errc_from_errno(e),
+        "cannot stat shm segment " + shm::wake_segment_name(name) + ": " + shm::errno_text(e));
+  }
+  impl->seg = init_pose_segment(mapping->get(), options, generation, wake_st.st_ino);
+  impl->remember_identity();
   impl->wake = static_cast<WakeSegment*>(impl->wake_mapping.get());
   impl->fd = std::move(fd).value();
   impl->mapping = std::move(mapping).value();
@@ -379,7 +474,14 @@ void ShmPoseWriter::update_status(const StatusRecord& status) {
   impl_->seg->status.store(s);
 }
 
-void ShmPoseWriter::heartbeat() { impl_->beat(); }
+void ShmPoseWriter::heartbeat() {
+  impl_->check_identity();
+  impl_->beat();
+}
+
+uint64_t ShmPoseWriter::header_repairs() const {
+  return impl_->header_repairs.load(std::memory_order_relaxed);
+}
 
 void ShmPoseWriter::mark_stopped() { impl_->mark_stopped(); }
 

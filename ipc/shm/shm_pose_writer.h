@@ -56,8 +56,12 @@ class ShmPoseWriter {
   // Replaces the status record (ceilposectl status). Stamps updated_mono_ns
   // when zero.
   void update_status(const StatusRecord& status);
-  // Refreshes the heartbeat (also done by publish() and the heartbeat thread).
+  // Refreshes the heartbeat (also done by publish() and the heartbeat
+  // thread) and restores the header's identity if something overwrote it.
   void heartbeat();
+  // Times the header's identity was found overwritten and restored (by
+  // heartbeat() or the heartbeat thread): the daemon says so in its log.
+  uint64_t header_repairs() const;
   // State "stopped", wakes every blocked reader. Call on SIGTERM. Ends the
   // heartbeat thread (waits for it, at most one period), so the last
   // heartbeat is the stop time.

@@ -105,5 +105,16 @@ TEST_F(DaemonHostile, ADurationThatWouldNeverEndIsAUsageError) {
   }
 }
 
+// A link another user put at the name: exit 5, which the unit does not
+// restart (RestartPreventExitStatus), instead of exit 1 every 2 s.
+TEST_F(DaemonHostile, ANameTakenInDevShmExitsFiveNamingWhatHoldsIt) {
+  const std::string squat = "/dev/shm" + shm_;
+  ASSERT_EQ(symlink("/etc/passwd", squat.c_str()), 0);
+  auto r = run_daemon(args({"--duration", "1"}), kBoundMs);
+  unlink(squat.c_str());
+  EXPECT_EQ(r.exit.code, daemon::kExitShmNameTaken) << r.err;
+  EXPECT_NE(r.err.find(squat + " is a symbolic link owned by uid"), std::string::npos) << r.err;
+}
+
 }  // namespace
 }  // namespace ceilpose::test

@@ -1,0 +1,128 @@
+// Issue 15: what a hostile local user, a group reader, or the owner's user
+// writing over the segment can do, and what the writer and readers do then.
+#include <fcntl.h>
+#include <gtest/gtest.h>
+#include <sys/file.h>
+#include <sys/mman.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include <cstring>
+#include <string>
+
+#include "ipc/shm/shm_layout.h"
+#include "ipc/shm/shm_pose_reader.h"
+#include "ipc/shm/shm_pose_writer.h"
+#include "shm_test_support.h"
+
+namespace ceilpose {
+namespace {
+
+using shm::ShmErrc;
+
+class ShmHostile : public test::ShmFixture {
+ protected:
+  std::string path(const std::string& name) const { return "/dev/shm" + name; }
+  // Writes `bytes` over the start of segment `name` through a mapping of
+  // its own, as another process of the owner's user would.
+  void scribble(const std::string& name, size_t bytes) {
+    const int fd = ::shm_open(name.c_str(), O_RDWR | O_CLOEXEC, 0);
+    ASSERT_GE(fd, 0) << name;
+    void* p = ::mmap(nullptr, bytes, PROT_READ | PROT_WRITE, MAP_SHARED, fd, 0);
+    ::close(fd);
+    ASSERT_NE(p, MAP_FAILED);
+    std::memset(p, 0x5a, bytes);
+    ::munmap(p, bytes);
+  }
+};
+
+// Any user can put a link or a directory at the daemon's name in the
+// sticky, world-writable /dev/shm; the writer used to fail with "cannot be
+// opened to check its writer" and systemd restarted it every 2 s.
+TEST_F(ShmHostile, ALinkOrADirectoryAtTheNameIsRefusedNamingItAndItsOwner) {
+  for (const bool directory : {false, true}) {
+    for (const std::string& squatted : {name(), shm::wake_segment_name(name())}) {
+      if (directory) {
+        ASSERT_EQ(::mkdir(path(squatted).c_str(), 0777), 0);
+      } else {
+        ASSERT_EQ(::symlink("/etc/passwd", path(squatted).c_str()), 0);
+      }
+      ShmOptions options;
+      options.name = name();
+      ShmErrc code = ShmErrc::kOk;
+      auto writer = ShmPoseWriter::create(options, &code);
+      EXPECT_FALSE(writer);
+      EXPECT_EQ(code, ShmErrc::kNameTaken);
+      if (!writer) {
+        const std::string& m = writer.error().message;
+        EXPECT_NE(m.find(path(squatted) + " is " + (directory ? "a directory" : "a symbolic link") +
+                         " owned by uid " + std::to_string(::geteuid())),
+                  std::string::npos)
+            << m;
+        EXPECT_NE(m.find("remove it (as its owner or root) or choose another ipc.shm_name"),
+                  std::string::npos)
+            << m;
+      }
+      directory ? ::rmdir(path(squatted).c_str()) : ::unlink(path(squatted).c_str());
+      (void)ShmPoseWriter::remove(name());
+    }
+  }
+}
+
+// A file of another user at the name, its lock held: before, "another
+// ceilposed (pid unknown) is publishing". Also what a root-run ceilposed
+// leaves behind for the User=ceilpose service.
+TEST_F(ShmHostile, AnotherUsersFileWithItsLockHeldIsNamedNotTakenForADaemon) {
+  if (::geteuid() != 0) GTEST_SKIP() << "needs root to make a file of another user";
+  const int fd = ::open(path(name()).c_str(), O_RDWR | O_CREAT | O_EXCL | O_CLOEXEC, 0666);
+  ASSERT_GE(fd, 0);
+  ASSERT_EQ(::fchown(fd, 65534, 65534), 0);
+  ASSERT_EQ(::flock(fd, LOCK_EX), 0);
+  ShmOptions options;
+  options.name = name();
+  ShmErrc code = ShmErrc::kOk;
+  auto writer = ShmPoseWriter::create(options, &code);
+  ::close(fd);
+  ASSERT_FALSE(writer);
+  EXPECT_EQ(code, ShmErrc::kNameTaken);
+  EXPECT_NE(writer.error().message.find(path(name()) + " is a file owned by uid 65534"),
+            std::string::npos)
+      << writer.error().message;
+}
+
+// The -wake segment is read-write for readers (they count themselves in
+// it). Four bytes written there by any group reader used to lock out every
+// new reader ("-wake does not belong").
+TEST_F(ShmHostile, GarbageInTheWakeSegmentLocksNoReaderOut) {
+  ASSERT_NO_FATAL_FAILURE(start());
+  ASSERT_NO_FATAL_FAILURE(scribble(shm::wake_segment_name(name()), 16));
+  ShmErrc code = ShmErrc::kOk;
+  auto late = ShmPoseReader::open(name(), &code);
+  ASSERT_TRUE(late) << late.error().message;
+  writer().publish(test::check_pose(1));
+  PoseRecord pose{};
+  EXPECT_EQ(late->wait_next(0, 2000, &pose), WaitResult::kPose);
+  EXPECT_EQ(pose.seq, 1u);
+}
+
+// Garbage over a live segment's header (its owner's user or root): new
+// readers said "bad magic" forever and the daemon never noticed. The
+// writer owns the header; its heartbeat puts it back and counts it.
+TEST_F(ShmHostile, TheWriterRestoresAnOverwrittenHeaderAndCountsIt) {
+  ASSERT_NO_FATAL_FAILURE(start(/*heartbeat_period_ms=*/0));
+  EXPECT_EQ(writer().header_repairs(), 0u);
+  ASSERT_NO_FATAL_FAILURE(scribble(name(), 64));
+  ShmErrc code = ShmErrc::kOk;
+  EXPECT_FALSE(ShmPoseReader::open(name(), &code)) << "the scribble must break the header";
+  EXPECT_EQ(code, ShmErrc::kBadMagic);
+  writer().heartbeat();
+  EXPECT_EQ(writer().header_repairs(), 1u);
+  auto late = ShmPoseReader::open(name(), &code);
+  ASSERT_TRUE(late) << late.error().message;
+  EXPECT_EQ(late->writer_info().generation, writer().generation());
+  writer().heartbeat();
+  EXPECT_EQ(writer().header_repairs(), 1u) << "an intact header is not repaired";
+}
+
+}  // namespace
+}  // namespace ceilpose
