@@ -3,6 +3,7 @@
 #include <fcntl.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <array>
 #include <cerrno>
 #include <charconv>
@@ -13,9 +14,11 @@
 #include <opencv2/core.hpp>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
+#include <string_view>
 #include <vector>
 
 #include "core/text_file.h"
+#include "core/unique_fd.h"
 #include "recording/frame_file.h"
 #include "recording/recording_format.h"
 
@@ -24,13 +27,6 @@ namespace ceilpose {
 namespace fmt = recording_format;
 
 namespace {
-
-struct FileCloser {
-  void operator()(std::FILE* f) const {
-    if (f != nullptr) std::fclose(f);
-  }
-};
-using FilePtr = std::unique_ptr<std::FILE, FileCloser>;
 
 // Shortest text that reads back to the same double, so rows round-trip exactly.
 std::string number_text(double v) {
@@ -86,7 +82,8 @@ std::string yaml_text(const RecordingCamera& camera) {
 struct RecordingWriter::State {
   std::string dir;
   RecordingCamera camera;
-  FilePtr csv;
+  UniqueFd csv;
+  off_t csv_bytes = 0;  // what frames.csv holds of whole lines
   size_t frames = 0;
   int64_t last_timestamp_ns = 0;
   bool ground_truth_columns = false;
@@ -135,9 +132,33 @@ Result<RecordingWriter> RecordingWriter::create(const std::string& dir,
   auto wrote = write_file(dir + "/" + fmt::kYamlName, yaml.data(), yaml.size());
   if (!wrote) return wrote.error();
   const std::string csv_path = dir + "/" + fmt::kCsvName;
-  w.s_->csv.reset(std::fopen(csv_path.c_str(), "we"));
-  if (!w.s_->csv) return make_error(csv_path + ": cannot create (" + std::strerror(errno) + ")");
+  w.s_->csv = UniqueFd(::open(csv_path.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644));
+  if (!w.s_->csv.valid())
+    return make_error(csv_path + ": cannot create (" + std::strerror(errno) + ")");
   return w;
+}
+
+// On a full disk what is on disk must stay a valid recording of the frames
+// written so far: each line goes out whole in unbuffered writes, and a line
+// cut short is cut off again, back to the last whole one.
+Result<void> RecordingWriter::append_lines(const char* data, size_t size) {
+  State& s = *s_;
+  size_t done = 0;
+  while (done < size) {
+    const ssize_t n = ::write(s.csv.get(), data + done, size - done);
+    if (n < 0 && errno == EINTR) continue;
+    if (n <= 0) {
+      const int e = n < 0 ? errno : ENOSPC;
+      const bool rolled_back = ::ftruncate(s.csv.get(), s.csv_bytes) == 0 &&
+                               ::lseek(s.csv.get(), s.csv_bytes, SEEK_SET) == s.csv_bytes;
+      return make_error(s.dir + "/" + fmt::kCsvName + ": write error (" + std::strerror(e) +
+                        "); the recording keeps its first " + std::to_string(s.frames) + " frames" +
+                        (rolled_back ? "" : " (the cut line could not be removed)"));
+    }
+    done += static_cast<size_t>(n);
+  }
+  s.csv_bytes += static_cast<off_t>(size);
+  return {};
 }
 
 Result<void> RecordingWriter::append(const ImageView& frame, int64_t timestamp_ns,
@@ -237,18 +258,23 @@ Result<void> RecordingWriter::append(const ImageView& frame, int64_t timestamp_n
   s.path += '/';
   s.path += name;
   auto wrote = write_file(s.path, bytes, size);
-  if (!wrote) return wrote;
+  if (!wrote) {
+    ::unlink(s.path.c_str());  // a frame file cut short is no frame
+    return make_error(wrote.error().message + "; the recording keeps its first " +
+                      std::to_string(s.frames) + " frames");
+  }
 
+  // [header] index,timestamp_ns,file[,gt_x_m,gt_y_m,gt_yaw_rad]: at most 3 x
+  // 20 digits, the name and 3 x 24 characters of shortest round-trip doubles.
+  std::array<char, 256> row{};
+  char* p = row.data();
   if (s.frames == 0) {
     s.ground_truth_columns = gt_columns;
-    std::fputs(gt_columns ? "index,timestamp_ns,file,gt_x_m,gt_y_m,gt_yaw_rad\n"
-                          : "index,timestamp_ns,file\n",
-               s.csv.get());
+    const std::string_view header = gt_columns
+                                        ? "index,timestamp_ns,file,gt_x_m,gt_y_m,gt_yaw_rad\n"
+                                        : "index,timestamp_ns,file\n";
+    p = std::copy(header.begin(), header.end(), p);
   }
-  // index,timestamp_ns,file[,gt_x_m,gt_y_m,gt_yaw_rad]: at most 3 x 20 digits,
-  // the name and 3 x 24 characters of shortest round-trip doubles.
-  std::array<char, 192> row{};
-  char* p = row.data();
   char* const end = row.data() + row.size() - 1;
   p = std::to_chars(p, end, s.frames).ptr;
   *p++ = ',';
@@ -262,9 +288,9 @@ Result<void> RecordingWriter::append(const ImageView& frame, int64_t timestamp_n
     }
   }
   *p++ = '\n';
-  if (std::fwrite(row.data(), 1, static_cast<size_t>(p - row.data()), s.csv.get()) !=
-      static_cast<size_t>(p - row.data())) {
-    return make_error(s.dir + "/" + fmt::kCsvName + ": write error (" + std::strerror(errno) + ")");
+  if (auto ok = append_lines(row.data(), static_cast<size_t>(p - row.data())); !ok) {
+    ::unlink(s.path.c_str());
+    return ok;
   }
   s.last_timestamp_ns = timestamp_ns;
   ++s.frames;
@@ -276,12 +302,19 @@ Result<void> RecordingWriter::close() {
   State& s = *s_;
   s.closed = true;
   const std::string csv_path = s.dir + "/" + fmt::kCsvName;
-  if (s.frames == 0) std::fputs("index,timestamp_ns,file\n", s.csv.get());
-  const bool failed = std::ferror(s.csv.get()) != 0;
-  std::FILE* f = s.csv.release();
-  if (std::fclose(f) != 0 || failed) {
-    return make_error(csv_path + ": write error (" + std::strerror(errno) + ")");
+  if (s.frames == 0 && s.csv_bytes == 0) {
+    constexpr std::string_view kHeader = "index,timestamp_ns,file\n";
+    if (auto ok = append_lines(kHeader.data(), kHeader.size()); !ok) return ok;
   }
+  // On disk before the command says it is done: frames.csv, and with
+  // syncfs the frame files and directory entries too (one call, not one
+  // fsync per frame).
+  if (::fsync(s.csv.get()) != 0)
+    return make_error(csv_path + ": cannot flush to disk (" + std::strerror(errno) + ")");
+  if (::syncfs(s.csv.get()) != 0)
+    return make_error(s.dir + ": cannot flush to disk (" + std::strerror(errno) + ")");
+  if (::close(s.csv.release()) != 0)
+    return make_error(csv_path + ": close error (" + std::strerror(errno) + ")");
   return {};
 }
 

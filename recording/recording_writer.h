@@ -41,6 +41,7 @@ class RecordingWriter {
 
  private:
   RecordingWriter();
+  Result<void> append_lines(const char* data, size_t size);
   struct State;
   std::unique_ptr<State> s_;
 };

@@ -2,8 +2,10 @@
 #include "recording/recording_writer.h"
 
 #include <gtest/gtest.h>
+#include <sys/resource.h>
 
 #include <cmath>
+#include <csignal>
 #include <cstring>
 #include <filesystem>
 #include <opencv2/core.hpp>
@@ -197,6 +199,34 @@ TEST(RecordingWriter, UsesAnExistingEmptyDirectory) {
   auto reader = RecordingReader::open(tmp.path());
   ASSERT_TRUE(reader.ok()) << reader.error().message;
   EXPECT_TRUE(reader->rows().empty());
+}
+
+// Issue 15: a full disk used to leave frames.csv cut mid-row with "76
+// frames written" reported. A file-size limit stands in for the full disk
+// (writes past it fail with EFBIG, after a partial write).
+TEST_F(RecordingWriterTest, AFullDiskLeavesAValidRecordingOfTheFramesWritten) {
+  const Pose2D gt{1.0, 2.0, 0.5};
+  ASSERT_EQ(append_pattern(1000, &gt), "");
+  const auto frame_bytes = std::filesystem::file_size(dir_ + "/frames/000000.png");
+  rlimit old{};
+  ASSERT_EQ(getrlimit(RLIMIT_FSIZE, &old), 0);
+  const rlimit small{static_cast<rlim_t>(frame_bytes + 100), old.rlim_max};
+  auto* const old_handler = std::signal(SIGXFSZ, SIG_IGN);
+  ASSERT_EQ(setrlimit(RLIMIT_FSIZE, &small), 0);
+  std::string error;
+  for (int64_t k = 1; k < 100000 && error.empty(); ++k) error = append_pattern(1000 + k, &gt);
+  setrlimit(RLIMIT_FSIZE, &old);
+  std::signal(SIGXFSZ, old_handler);
+  const size_t kept = writer_->frames_written();
+  ASSERT_GE(kept, 2u);
+  expect_mentions(error,
+                  {"frames.csv: write error (File too large); the recording keeps its first " +
+                   std::to_string(kept) + " frames"});
+  ASSERT_TRUE(writer_->close().ok());
+  auto reader = RecordingReader::open(dir_);
+  ASSERT_TRUE(reader.ok()) << reader.error().message;
+  EXPECT_EQ(reader->rows().size(), kept);
+  EXPECT_TRUE(reader->has_ground_truth_columns());
 }
 
 TEST_F(RecordingWriterTest, RefusesDecreasingTimestamps) {
