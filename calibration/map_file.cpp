@@ -55,7 +55,9 @@ Result<void> read_marker(const std::string& path, const YAML::Node& node, size_t
   }
   const YAML::Node code = node["code"];
   int ij[2] = {0, 0};
-  bool code_ok = code.IsSequence() && code.size() == 2;
+  // A missing key is an invalid node, whose type yaml-cpp throws for
+  // (found by fuzz_map).
+  bool code_ok = code.IsDefined() && code.IsSequence() && code.size() == 2;
   for (int k = 0; code_ok && k < 2; ++k)
     code_ok = code[k].IsScalar() && YAML::convert<int>::decode(code[k], ij[k]);
   if (!code_ok) {
@@ -103,7 +105,19 @@ Result<void> read_marker(const std::string& path, const YAML::Node& node, size_t
 
 }  // namespace
 
+static Result<CeilingMap> read_map(const std::string& path, const CeilingLayout& layout);
+
 Result<CeilingMap> read_map_file(const std::string& path, const CeilingLayout& layout) {
+  // What yaml-cpp may still throw on a node shape the checks above did not
+  // foresee is an error in the file, not a crash.
+  try {
+    return read_map(path, layout);
+  } catch (const YAML::Exception& e) {
+    return make_error(path + ": malformed ceiling map (" + e.what() + ")");
+  }
+}
+
+static Result<CeilingMap> read_map(const std::string& path, const CeilingLayout& layout) {
   auto root = load_yaml_mapping(path, "ceiling map");
   if (!root) return root.error();
   if (auto known = only_keys(path, *root, {"format", "version", "ceiling", "markers"}, "");

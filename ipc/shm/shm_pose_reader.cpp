@@ -392,7 +392,11 @@ Liveness ShmPoseReader::liveness(int64_t stale_after_ms) const {
   if (state == WriterState::kStopped) return Liveness::kStopped;
   if (!shm::process_exists(h.writer_pid)) return Liveness::kWriterDead;
   const int64_t age_ns = monotonic_ns() - h.heartbeat_mono_ns.load(std::memory_order_acquire);
-  if (age_ns > this->stale_after_ms(stale_after_ms) * 1'000'000) return Liveness::kStale;
+  const int64_t stale_ns = this->stale_after_ms(stale_after_ms) * 1'000'000;
+  // A heartbeat from the future beyond the staleness limit: this reader's
+  // CLOCK_MONOTONIC is not the writer's (another time namespace), and no
+  // age can be told; never "live" then.
+  if (age_ns > stale_ns || age_ns < -stale_ns) return Liveness::kStale;
   if (state == WriterState::kStarting) return Liveness::kStarting;
   return Liveness::kLive;
 }

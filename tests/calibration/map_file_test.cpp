@@ -94,6 +94,9 @@ INSTANTIATE_TEST_SUITE_P(
                ":2: unsupported version 2"},
         BadMap{"Twice", std::string(kHeader) + kOne + kOne,
                ":11: markers[1] (code [1, 2]): code listed twice"},
+        // Found by fuzz_map: yaml-cpp threw for the missing key (a crash).
+        BadMap{"MarkerWithoutCode", std::string(kHeader) + "  - \n    observations: 143\n",
+               ":9: markers[0].code must be a pair of integers [i, j]"},
         BadMap{"OutsideBits", std::string(kHeader) + "  - code: [8, 0]\n    x_m: 0\n    y_m: 0\n",
                ":8: markers[0] (code [8, 0]): code outside the ceiling's 8 x 8 codes"},
         BadMap{"Negative", std::string(kHeader) + "  - code: [-1, 0]\n    x_m: 0\n    y_m: 0\n",

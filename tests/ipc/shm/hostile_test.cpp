@@ -10,6 +10,7 @@
 #include <cstring>
 #include <string>
 
+#include "core/clock.h"
 #include "ipc/shm/shm_layout.h"
 #include "ipc/shm/shm_pose_reader.h"
 #include "ipc/shm/shm_pose_writer.h"
@@ -122,6 +123,22 @@ TEST_F(ShmHostile, TheWriterRestoresAnOverwrittenHeaderAndCountsIt) {
   EXPECT_EQ(late->writer_info().generation, writer().generation());
   writer().heartbeat();
   EXPECT_EQ(writer().header_repairs(), 1u) << "an intact header is not repaired";
+}
+
+// A reader in another time namespace (its CLOCK_MONOTONIC behind the
+// writer's) used to count the negative age of every heartbeat as live.
+TEST_F(ShmHostile, AHeartbeatFromTheFutureIsNotLive) {
+  ASSERT_NO_FATAL_FAILURE(start(/*heartbeat_period_ms=*/0));
+  writer().publish(test::check_pose(1));
+  EXPECT_EQ(reader().liveness(500), Liveness::kLive);
+  const int fd = ::shm_open(name().c_str(), O_RDWR | O_CLOEXEC, 0);
+  ASSERT_GE(fd, 0);
+  void* p = ::mmap(nullptr, sizeof(shm::SegmentHeader), PROT_READ | PROT_WRITE, MAP_SHARED, fd, 0);
+  ::close(fd);
+  ASSERT_NE(p, MAP_FAILED);
+  static_cast<shm::SegmentHeader*>(p)->heartbeat_mono_ns.store(monotonic_ns() + 10'000'000'000);
+  EXPECT_EQ(reader().liveness(500), Liveness::kStale);
+  ::munmap(p, sizeof(shm::SegmentHeader));
 }
 
 }  // namespace

@@ -1,0 +1,34 @@
+#include "fuzz/fuzz_support.h"
+
+#include <unistd.h>
+
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+
+namespace ceilpose::fuzz {
+
+const std::string& scratch_dir() {
+  static const std::string dir = "/dev/shm/ceilpose-fuzz-" + std::to_string(::getpid());
+  std::error_code ec;
+  std::filesystem::remove_all(dir, ec);
+  std::filesystem::create_directories(dir, ec);
+  return dir;
+}
+
+void write_bytes(const std::string& path, std::string_view bytes) {
+  std::ofstream(path, std::ios::binary)
+      .write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
+}
+
+void split_input(const uint8_t* data, size_t size, std::string_view* parts, int count) {
+  constexpr std::string_view kCut = "\n--8<--\n";
+  std::string_view rest(reinterpret_cast<const char*>(data), size);
+  for (int k = 0; k < count; ++k) {
+    const size_t at = k + 1 < count ? rest.find(kCut) : std::string_view::npos;
+    parts[k] = rest.substr(0, at);
+    rest = at == std::string_view::npos ? std::string_view() : rest.substr(at + kCut.size());
+  }
+}
+
+}  // namespace ceilpose::fuzz
