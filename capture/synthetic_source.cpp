@@ -47,11 +47,14 @@ NextStatus SyntheticSource::do_next(Frame* out, int timeout_ms) {
   const int64_t now_ns = monotonic_ns();
   int64_t due_ns = start_ns_ + static_cast<int64_t>(tick_) * period_ns_;
   if (now_ns - due_ns >= period_ns_) {
-    // Behind by whole frames: those exposures never happened; resume at the
-    // most recent tick.
-    const uint64_t current = static_cast<uint64_t>((now_ns - start_ns_) / period_ns_);
-    stats_.drops += current - tick_;
-    tick_ = current;
+    // Behind by whole frames: those exposures never happened. Resume at the
+    // next tick, as a camera would, not at the one that already passed: the
+    // capture thread then sleeps between renders even when rendering is
+    // slower than the frame rate, so a SCHED_FIFO capture thread cannot take
+    // a core for good (it starved every SCHED_OTHER thread on the machine).
+    const uint64_t next = static_cast<uint64_t>((now_ns - start_ns_) / period_ns_) + 1;
+    stats_.drops += next - tick_;
+    tick_ = next;
     due_ns = start_ns_ + static_cast<int64_t>(tick_) * period_ns_;
   }
   const int64_t deadline_ns = now_ns + static_cast<int64_t>(timeout_ms) * 1'000'000;

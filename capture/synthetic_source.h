@@ -6,7 +6,8 @@
 // capture knows frames only: nothing here knows what the image shows.
 //
 // If rendering falls behind the frame rate, the ticks that passed are counted
-// as drops (as a camera would lose them) and the next frame is the current one.
+// as drops (as a camera would lose them) and the next frame is the next tick,
+// so the capture thread always sleeps between two renders.
 //
 // Threads: see FrameSource; one thread (the capture thread) only.
 #include <memory>

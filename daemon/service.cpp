@@ -1,5 +1,7 @@
 #include "daemon/service.h"
 
+#include <pthread.h>
+#include <sched.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -7,6 +9,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <cstring>
 #include <memory>
 #include <numbers>
 #include <sstream>
@@ -97,6 +100,7 @@ class Service {
   int start_shared_memory();
   int start_dds();
   int start_pipeline();
+  void raise_control_priority();
   void loop();
   void reload();
   void shutdown();
@@ -135,6 +139,7 @@ int Service::start() {
                                  &Service::start_dds, &Service::start_pipeline}) {
     if (const int rc = (this->*step)(); rc != kExitOk) return rc;
   }
+  raise_control_priority();
   notifier_.ready("running, waiting for the first frame");
   return kExitOk;
 }
@@ -221,6 +226,31 @@ int Service::start_pipeline() {
                worker_->realtime() ? ", pipeline SCHED_FIFO " + std::to_string(wopts.rt_priority)
                                    : std::string());
   return kExitOk;
+}
+
+// The control thread answers signals and feeds the watchdog. When the frame
+// path cannot keep up (a slow board, a synthetic camera rendering back to
+// back), its SCHED_FIFO threads take every core and a SCHED_OTHER control
+// thread would not run for minutes: SIGTERM went unanswered for 34 min with
+// two such daemons on 2 cores. It sleeps almost always, so running it one
+// above the frame path costs the frames nothing. Last of the start steps, so
+// that no thread (DDS's among them) inherits the priority.
+void Service::raise_control_priority() {
+  const int frame_path_priority =
+      std::max(capture_->realtime().fifo ? capture_->realtime().priority : 0,
+               worker_->realtime() ? config_.capture.pipeline_rt_priority : 0);
+  if (frame_path_priority == 0) return;
+  sched_param param{};
+  param.sched_priority = std::min(frame_path_priority + 1, sched_get_priority_max(SCHED_FIFO));
+  if (const int r = pthread_setschedparam(pthread_self(), SCHED_FIFO, &param); r != 0) {
+    spdlog::warn(
+        "control thread: cannot run SCHED_FIFO {} above the frame path: {}; SIGTERM and the "
+        "watchdog may wait while the frame path is saturated (LimitRTPRIO= must allow {})",
+        param.sched_priority, std::strerror(r), param.sched_priority);
+    return;
+  }
+  spdlog::info("control thread: SCHED_FIFO {}, above the frame path's {}", param.sched_priority,
+               frame_path_priority);
 }
 
 void Service::loop() {

@@ -4,6 +4,9 @@
 
 #include <gtest/gtest.h>
 
+#include <chrono>
+#include <thread>
+
 #include "sim/trajectory.h"
 #include "sim/trajectory_camera.h"
 
@@ -125,6 +128,38 @@ TEST(SyntheticSource, FramesFollowTheConfiguredRateOnTheMonotonicClock) {
     previous_ns = f.capture_ns;
     source.release(f);
   }
+}
+
+// Rendering slower than the frame rate: a SCHED_FIFO capture thread that
+// rendered back to back held its core for good and starved the daemon's own
+// control thread (SIGTERM unanswered for minutes). Every exposure must begin
+// after the previous render ended, so the thread sleeps between renders.
+struct SlowGenerator final : FrameGenerator {
+  const CameraIntrinsics& intrinsics() const override { return stamping.k; }
+  void generate(int64_t elapsed_ns, uint64_t tick, Image* out, Pose2D* truth) override {
+    std::this_thread::sleep_for(std::chrono::milliseconds(25));  // 2.5 periods at 100 fps
+    stamping.generate(elapsed_ns, tick, out, truth);
+  }
+  std::string describe() const override { return "slow"; }
+  StampingGenerator stamping;
+};
+
+TEST(SyntheticSource, RenderingSlowerThanTheRateWaitsForTheNextTickNotAPassedOne) {
+  SyntheticSource source(at_rate(100.0), std::make_shared<SlowGenerator>());
+  ASSERT_TRUE(source.open());
+  ASSERT_TRUE(source.start());
+  int64_t previous_rendered_ns = 0;
+  for (int i = 0; i < 5; ++i) {
+    Frame f;
+    int calls = 0;
+    while (source.next(&f, 100) != NextStatus::kFrame) ASSERT_LT(++calls, 100);
+    if (i > 0) {
+      EXPECT_GT(f.capture_ns, previous_rendered_ns) << "frame " << i << " exposed in the past";
+    }
+    previous_rendered_ns = f.dequeue_ns;
+    source.release(f);
+  }
+  EXPECT_GE(source.stats().drops, 8u);  // >= 2 ticks lost per frame after the first
 }
 
 TEST(SyntheticSource, TheImageShowsTheCeilingNotABlank) {
