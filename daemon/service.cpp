@@ -232,7 +232,7 @@ int Service::start_pipeline() {
 // path cannot keep up (a slow board, a synthetic camera rendering back to
 // back), its SCHED_FIFO threads take every core and a SCHED_OTHER control
 // thread would not run for minutes: SIGTERM went unanswered for 34 min with
-// two such daemons on 2 cores. It sleeps almost always, so running it one
+// three such daemons on 2 cores. It sleeps almost always, so running it one
 // above the frame path costs the frames nothing. Last of the start steps, so
 // that no thread (DDS's among them) inherits the priority.
 void Service::raise_control_priority() {

@@ -35,6 +35,13 @@ std::shared_ptr<FrameGenerator> small_camera() {
   return std::make_shared<sim::TrajectoryCamera>(small_scene());
 }
 
+// The next frame within 100 polls of 100 ms; false if none came.
+bool wait_frame(SyntheticSource& source, Frame* f) {
+  for (int calls = 0; calls < 100; ++calls)
+    if (source.next(f, 100) == NextStatus::kFrame) return true;
+  return false;
+}
+
 // Proves capture needs nothing of the simulator: a generator that only
 // stamps what it was asked.
 struct StampingGenerator final : FrameGenerator {
@@ -116,8 +123,7 @@ TEST(SyntheticSource, FramesFollowTheConfiguredRateOnTheMonotonicClock) {
   int64_t previous_ns = 0;
   for (int i = 0; i < 6; ++i) {
     Frame f;
-    int calls = 0;
-    while (source.next(&f, 100) != NextStatus::kFrame) ASSERT_LT(++calls, 100);
+    ASSERT_TRUE(wait_frame(source, &f));
     if (i > 0) {
       // Capture times sit on the 10 ms grid; a loaded machine may skip ticks
       // (counted as drops) but never moves a frame off the grid.
@@ -151,8 +157,7 @@ TEST(SyntheticSource, RenderingSlowerThanTheRateWaitsForTheNextTickNotAPassedOne
   int64_t previous_rendered_ns = 0;
   for (int i = 0; i < 5; ++i) {
     Frame f;
-    int calls = 0;
-    while (source.next(&f, 100) != NextStatus::kFrame) ASSERT_LT(++calls, 100);
+    ASSERT_TRUE(wait_frame(source, &f));
     if (i > 0) {
       EXPECT_GT(f.capture_ns, previous_rendered_ns) << "frame " << i << " exposed in the past";
     }
@@ -167,8 +172,7 @@ TEST(SyntheticSource, TheImageShowsTheCeilingNotABlank) {
   ASSERT_TRUE(source.open());
   ASSERT_TRUE(source.start());
   Frame f;
-  int calls = 0;
-  while (source.next(&f, 100) != NextStatus::kFrame) ASSERT_LT(++calls, 100);
+  ASSERT_TRUE(wait_frame(source, &f));
   int lo = 255;
   int hi = 0;
   for (int y = 0; y < f.image.height; ++y) {
