@@ -274,6 +274,7 @@ void Service::loop() {
   uint64_t printed_frame = 0;
   PosePrinter printer(start_ns_);
   uint64_t header_repairs = 0;
+  uint64_t truncations = 0;
   bool stalled_reported = false;
 
   for (;;) {
@@ -318,6 +319,13 @@ void Service::loop() {
     }
     if (now >= next_status) {
       next_status = now + status_period_ns;
+      if (shm_ && shm_->truncations() != truncations) {
+        truncations = shm_->truncations();
+        spdlog::error(
+            "shared memory: {} (or its -wake companion) was truncated by another process (its "
+            "owner's user or root); grown back to its size, {} times so far; readers re-attach",
+            shm_->name(), truncations);
+      }
       if (shm_ && shm_->header_repairs() != header_repairs) {
         header_repairs = shm_->header_repairs();
         spdlog::error(

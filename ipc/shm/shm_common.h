@@ -40,6 +40,18 @@ Error fail(ShmErrc* out, ShmErrc code, std::string message);
 bool valid_shm_name(const std::string& name);
 std::string wake_segment_name(const std::string& name);
 
+// What a mapping does when the file under it shrinks (truncate(1) by the
+// segment's owner or root). Touching a page past the new end raises SIGBUS,
+// which kills the process unless handled; map_shared() installs a handler
+// (once per process, chaining to any handler installed before it) that
+// repairs a fault inside a registered mapping and returns:
+enum class OnShrink {
+  kRegrow,  // the writer: ftruncate(2) the file back to the mapped size; the
+            // access then lands on fresh zero pages, which the writer refills
+  kDetach,  // a reader: put anonymous zero pages over the whole mapping and
+            // mark it lost(); the reader re-opens the name (Liveness::kRestarted)
+};
+
 class Mapping {
  public:
   Mapping() = default;
@@ -53,14 +65,23 @@ class Mapping {
   void* get() const { return address_; }
   size_t size_bytes() const { return size_bytes_; }
   void reset();
+  // kDetach: the file shrank under this mapping, which now holds zeros.
+  bool lost() const;
+  // kRegrow: how many times the file was found shrunk and grown back.
+  uint64_t regrown() const;
 
  private:
+  friend Mapping map_shared(int fd, size_t size_bytes, bool writable, OnShrink on_shrink,
+                            int* error);
   void* address_ = nullptr;
   size_t size_bytes_ = 0;
+  int guard_slot_ = -1;  // its entry in the SIGBUS handler's table, -1: none
 };
 
-// mmap(MAP_SHARED) of `size_bytes` of `fd`; returns -errno in *error on failure.
-Mapping map_shared(int fd, size_t size_bytes, bool writable, int* error);
+// mmap(MAP_SHARED) of `size_bytes` of `fd`, guarded against the file
+// shrinking (see OnShrink; kRegrow keeps using `fd`, which must outlive the
+// mapping); returns -errno in *error on failure.
+Mapping map_shared(int fd, size_t size_bytes, bool writable, OnShrink on_shrink, int* error);
 
 // kill(pid, 0): true unless the process certainly does not exist (ESRCH).
 bool process_exists(int pid);

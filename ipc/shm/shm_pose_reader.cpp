@@ -173,8 +173,8 @@ Result<OpenedSegment> open_pose_segment(const std::string& name, ShmErrc* code) 
                     std::to_string(sizeof(Segment)) + " bytes)");
   }
   int map_error = 0;
-  out.mapping =
-      shm::map_shared(out.fd.get(), std::min(size_bytes, sizeof(Segment)), false, &map_error);
+  out.mapping = shm::map_shared(out.fd.get(), std::min(size_bytes, sizeof(Segment)), false,
+                                shm::OnShrink::kDetach, &map_error);
   if (out.mapping.get() == nullptr) {
     return fail(code, shm::errc_from_errno(map_error),
                 "cannot map shm segment " + name + " (" + std::to_string(size_bytes) +
@@ -246,7 +246,8 @@ Result<OpenedSegment> open_wake_segment(const std::string& name, uint64_t genera
                     " (its writer is starting or replacing it)");
   }
   int map_error = 0;
-  out.mapping = shm::map_shared(out.fd.get(), sizeof(WakeSegment), true, &map_error);
+  out.mapping =
+      shm::map_shared(out.fd.get(), sizeof(WakeSegment), true, shm::OnShrink::kDetach, &map_error);
   if (out.mapping.get() == nullptr) {
     return fail(code, shm::errc_from_errno(map_error),
                 "cannot map shm segment " + wake_name + ": " + shm::errno_text(map_error));
@@ -356,6 +357,7 @@ WaitResult ShmPoseReader::wait_next(uint64_t after_seq, int timeout_ms, PoseReco
     return read_latest(out) == ReadResult::kOk ? WaitResult::kPose : WaitResult::kBusy;
   };
   for (;;) {
+    if (lost()) return WaitResult::kWriterDead;  // liveness() says kRestarted: re-open
     if (r.latest_seq() > after_seq) return take();
     if (r.state() == WriterState::kStopped) return WaitResult::kStopped;
     // Register, then sample the futex word, then re-check: the writer stores
@@ -433,6 +435,7 @@ int64_t ShmPoseReader::stale_after_ms(int64_t requested) const {
 uint64_t ShmPoseReader::latest_seq() const { return impl_->latest_seq(); }
 
 bool ShmPoseReader::replaced() const {
+  if (lost()) return true;
   UniqueFd fd(::shm_open(impl_->name.c_str(), O_RDONLY | O_CLOEXEC, 0));
   if (!fd.valid()) return false;
   struct stat st {};
@@ -440,6 +443,8 @@ bool ShmPoseReader::replaced() const {
   // Our mapping keeps the old inode alive, so its number cannot be reused.
   return st.st_dev != impl_->dev || st.st_ino != impl_->ino;
 }
+
+bool ShmPoseReader::lost() const { return impl_->mapping.lost() || impl_->wake_mapping.lost(); }
 
 Result<void> ShmPoseReader::reattach(ShmErrc* code) {
   auto fresh = open(impl_->name, code);

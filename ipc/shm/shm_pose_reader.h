@@ -71,8 +71,12 @@ class ShmPoseReader {
   int read_recent(PoseRecord* out, int max_poses) const;
   WriterInfo writer_info() const;
   uint64_t latest_seq() const;
-  // True when the name now refers to another segment than the one mapped.
+  // True when the name now refers to another segment than the one mapped,
+  // or the segment was truncated under this reader (lost()).
   bool replaced() const;
+  // The file shrank under the mapping (truncate(1) by its owner or root):
+  // what was mapped now reads as zeros; reattach() to the name.
+  bool lost() const;
   // Re-opens the name; on success this reader switches to the new segment,
   // on failure it keeps the old one.
   Result<void> reattach(shm::ShmErrc* code = nullptr);

@@ -43,7 +43,7 @@ int existing_writer_pid(int fd) {
   struct stat st {};
   if (::fstat(fd, &st) != 0 || static_cast<size_t>(st.st_size) != sizeof(Segment)) return 0;
   int error = 0;
-  Mapping m = shm::map_shared(fd, sizeof(Segment), false, &error);
+  Mapping m = shm::map_shared(fd, sizeof(Segment), false, shm::OnShrink::kDetach, &error);
   if (m.get() == nullptr) return 0;
   const auto* seg = static_cast<const Segment*>(m.get());
   if (seg->header.magic.load(std::memory_order_acquire) != shm::kMagic) return 0;
@@ -55,7 +55,7 @@ void wake_readers_of(int fd) {
   struct stat st {};
   if (::fstat(fd, &st) != 0 || static_cast<size_t>(st.st_size) != sizeof(Segment)) return;
   int error = 0;
-  Mapping m = shm::map_shared(fd, sizeof(Segment), false, &error);
+  Mapping m = shm::map_shared(fd, sizeof(Segment), false, shm::OnShrink::kDetach, &error);
   if (m.get() == nullptr) return;
   futex_wake_all(&static_cast<const Segment*>(m.get())->header.wake_seq, FutexScope::kShared);
 }
@@ -106,6 +106,8 @@ struct ShmPoseWriter::Impl {
   // (the owner's user or root: readers map it read-only) wrote over it.
   shm::SegmentHeader identity{};
   std::atomic<uint64_t> header_repairs{0};
+  // The state this writer last stored, for check_identity (another thread).
+  std::atomic<uint32_t> state_of_record{static_cast<uint32_t>(WriterState::kStarting)};
   std::mutex identity_mutex;  // try-locked: one checker at a time, nobody waits
 
   std::mutex heartbeat_mutex;
@@ -152,6 +154,15 @@ struct ShmPoseWriter::Impl {
         h.writer_pid == i.writer_pid && h.generation == i.generation &&
         h.start_mono_ns == i.start_mono_ns && h.start_real_ns == i.start_real_ns &&
         h.stale_after_ms == i.stale_after_ms && h.wake_inode == i.wake_inode;
+    const uint32_t state = state_of_record.load(std::memory_order_acquire);
+    if (h.state.load(std::memory_order_acquire) != state) {
+      h.state.store(state, std::memory_order_release);  // zeroed by a truncation, or overwritten
+      if (intact) header_repairs.fetch_add(1, std::memory_order_relaxed);
+    }
+    if (wake->magic.load(std::memory_order_acquire) != shm::kWakeMagic) {
+      wake->generation = i.generation;
+      wake->magic.store(shm::kWakeMagic, std::memory_order_release);
+    }
     if (intact) return;
     h.magic.store(0, std::memory_order_release);
     h.abi_version = i.abi_version;
@@ -185,8 +196,13 @@ struct ShmPoseWriter::Impl {
   void mark_stopped() {
     // The last heartbeat then tells readers when the daemon stopped.
     stop_heartbeat_thread();
-    seg->header.state.store(static_cast<uint32_t>(WriterState::kStopped),
+    {
+      std::lock_guard<std::mutex> lock(identity_mutex);
+      state_of_record.store(static_cast<uint32_t>(WriterState::kStopped),
                             std::memory_order_release);
+      seg->header.state.store(static_cast<uint32_t>(WriterState::kStopped),
+                              std::memory_order_release);
+    }
     beat();
     stopped = true;
     wake_readers(true);
@@ -322,7 +338,7 @@ Result<Mapping> size_and_map(int fd, const std::string& name, size_t size_bytes,
                     " bytes: " + shm::errno_text(e));
   }
   int map_error = 0;
-  Mapping mapping = shm::map_shared(fd, size_bytes, true, &map_error);
+  Mapping mapping = shm::map_shared(fd, size_bytes, true, shm::OnShrink::kRegrow, &map_error);
   if (mapping.get() == nullptr) {
     return fail(code, shm::errc_from_errno(map_error),
                 "cannot map shm segment " + name + " (" + std::to_string(size_bytes) +
@@ -460,6 +476,10 @@ void ShmPoseWriter::publish(const PoseRecord& pose) {
   w.seg->ring[(p.seq - 1) % shm::kRingLength].store(p);
   h.latest_seq.store(p.seq, std::memory_order_release);
   if (!w.running && !w.stopped) {
+    // Once per run; check_identity must not see one of the two stores alone.
+    std::lock_guard<std::mutex> lock(w.identity_mutex);
+    w.state_of_record.store(static_cast<uint32_t>(WriterState::kRunning),
+                            std::memory_order_release);
     h.state.store(static_cast<uint32_t>(WriterState::kRunning), std::memory_order_release);
     w.running = true;
   }
@@ -481,6 +501,10 @@ void ShmPoseWriter::heartbeat() {
 
 uint64_t ShmPoseWriter::header_repairs() const {
   return impl_->header_repairs.load(std::memory_order_relaxed);
+}
+
+uint64_t ShmPoseWriter::truncations() const {
+  return impl_->mapping.regrown() + impl_->wake_mapping.regrown();
 }
 
 void ShmPoseWriter::mark_stopped() { impl_->mark_stopped(); }

@@ -62,6 +62,10 @@ class ShmPoseWriter {
   // Times the header's identity was found overwritten and restored (by
   // heartbeat() or the heartbeat thread): the daemon says so in its log.
   uint64_t header_repairs() const;
+  // Times the segment or its -wake companion was found truncated (SIGBUS on
+  // a write) and grown back to its size; the zeroed header is then restored
+  // like an overwritten one.
+  uint64_t truncations() const;
   // State "stopped", wakes every blocked reader. Call on SIGTERM. Ends the
   // heartbeat thread (waits for it, at most one period), so the last
   // heartbeat is the stop time.

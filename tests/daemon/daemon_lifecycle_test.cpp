@@ -173,6 +173,35 @@ TEST_F(DaemonLifecycle, ANotifySocketNobodyReadsDoesNotHoldUpSigterm) {
       << daemon->err();
 }
 
+// Issue 15: truncate(1) of the live segment (its owner's user or root) used
+// to kill the daemon with SIGBUS. It grows the file back, restores the
+// header, says so, and readers get poses again after re-attaching.
+TEST_F(DaemonLifecycle, TruncatingTheSegmentKillsNeitherTheDaemonNorItsReaders) {
+  auto daemon = start();
+  ASSERT_TRUE(notify_.wait_for("READY=1", kStartTimeoutMs)) << daemon->err();
+  auto reader = ShmPoseReader::open_waiting(shm_, 5000);
+  ASSERT_TRUE(reader) << reader.error().message;
+  PoseRecord pose = next_pose(*reader, 0);
+  ASSERT_NE(pose.seq, 0u) << daemon->err();
+  ASSERT_EQ(::truncate(("/dev/shm" + shm_).c_str(), 0), 0);
+  daemon->read_error_until("was truncated by another process", 5000);
+  EXPECT_NE(daemon->err().find("shared memory: " + shm_ +
+                               " (or its -wake companion) was truncated by another process"),
+            std::string::npos)
+      << daemon->err();
+  const uint64_t before = pose.seq;
+  if (reader->liveness() == Liveness::kRestarted) {
+    ASSERT_TRUE(reader->reattach());
+  }
+  pose = next_pose(*reader, before);
+  EXPECT_GT(pose.seq, before) << "poses flow again, numbered on";
+  EXPECT_TRUE(pose_is_valid(pose));
+  daemon->signal(SIGTERM);
+  const auto exit = daemon->wait(5000);
+  ASSERT_TRUE(exit.has_value()) << daemon->err();
+  EXPECT_EQ(exit->code, daemon::kExitOk) << daemon->err();
+}
+
 TEST_F(DaemonLifecycle, SigintStopsCleanlyToo) {
   auto daemon = start();
   ASSERT_TRUE(notify_.wait_for("READY=1", kStartTimeoutMs)) << daemon->err();

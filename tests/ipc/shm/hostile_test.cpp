@@ -5,8 +5,11 @@
 #include <sys/file.h>
 #include <sys/mman.h>
 #include <sys/stat.h>
+#include <sys/wait.h>
 #include <unistd.h>
 
+#include <csignal>
+#include <cstdlib>
 #include <cstring>
 #include <string>
 
@@ -123,6 +126,85 @@ TEST_F(ShmHostile, TheWriterRestoresAnOverwrittenHeaderAndCountsIt) {
   EXPECT_EQ(late->writer_info().generation, writer().generation());
   writer().heartbeat();
   EXPECT_EQ(writer().header_repairs(), 1u) << "an intact header is not repaired";
+}
+
+// truncate(1) of a live segment by its owner or root used to kill the
+// daemon and every attached reader with SIGBUS. Now the writer grows the file
+// back at its next write and restores the header; a reader that touches the
+// lost pages gets zeros instead, sees Liveness::kRestarted and re-attaches.
+TEST_F(ShmHostile, ATruncatedSegmentKillsNeitherTheReaderNorTheWriter) {
+  ASSERT_NO_FATAL_FAILURE(start(/*heartbeat_period_ms=*/0));
+  writer().publish(test::check_pose(1));
+  PoseRecord pose{};
+  ASSERT_EQ(reader().read_latest(&pose), ReadResult::kOk);
+  ASSERT_EQ(::truncate(path(name()).c_str(), 0), 0);
+
+  EXPECT_EQ(reader().read_latest(&pose), ReadResult::kNoPose) << "the lost pages read as zeros";
+  EXPECT_TRUE(reader().lost());
+  EXPECT_EQ(reader().liveness(500), Liveness::kRestarted);
+  EXPECT_EQ(reader().wait_next(1, 2000, &pose), WaitResult::kWriterDead) << "returns at once";
+
+  writer().publish(test::check_pose(2));
+  EXPECT_EQ(writer().truncations(), 1u);
+  struct stat st {};
+  ASSERT_EQ(::stat(path(name()).c_str(), &st), 0);
+  EXPECT_EQ(static_cast<size_t>(st.st_size), sizeof(shm::Segment));
+  writer().heartbeat();
+  EXPECT_GE(writer().header_repairs(), 1u);
+  ASSERT_TRUE(reader().reattach()) << "the restored header is valid again";
+  EXPECT_FALSE(reader().lost());
+  ASSERT_EQ(reader().read_latest(&pose), ReadResult::kOk);
+  EXPECT_EQ(pose.seq, 2u);
+  EXPECT_EQ(reader().liveness(500), Liveness::kLive);
+}
+
+// The -wake companion is what blocked readers count themselves in.
+TEST_F(ShmHostile, ATruncatedWakeSegmentKillsNeitherTheReaderNorTheWriter) {
+  ASSERT_NO_FATAL_FAILURE(start(/*heartbeat_period_ms=*/0));
+  writer().publish(test::check_pose(1));
+  ASSERT_EQ(::truncate(path(shm::wake_segment_name(name())).c_str(), 0), 0);
+  PoseRecord pose{};
+  EXPECT_NE(reader().wait_next(1, 100, &pose), WaitResult::kPose);
+  EXPECT_TRUE(reader().lost());
+  EXPECT_EQ(reader().liveness(500), Liveness::kRestarted);
+  writer().publish(test::check_pose(2));
+  EXPECT_EQ(writer().truncations(), 1u);
+  writer().heartbeat();
+  ASSERT_TRUE(reader().reattach());
+  EXPECT_EQ(reader().wait_next(1, 2000, &pose), WaitResult::kPose);
+  EXPECT_EQ(pose.seq, 2u);
+}
+
+// A SIGBUS that is not about a segment still kills the process, as it would
+// without the library's handler.
+bool dies_of_sigbus(int status) {
+#if defined(__SANITIZE_ADDRESS__)
+  // The handler chains to ASan's, which reports the fault and aborts.
+  return WIFSIGNALED(status) || (WIFEXITED(status) && WEXITSTATUS(status) == 1);
+#else
+  return WIFSIGNALED(status) && WTERMSIG(status) == SIGBUS;
+#endif
+}
+
+TEST(ShmSigbusGuard, AFaultOutsideEverySegmentStillKills) {
+  EXPECT_EXIT(
+      {
+        test::ScopedSegmentName other;
+        ShmOptions options;
+        options.name = other.str();
+        auto writer = ShmPoseWriter::create(options);  // installs the handler
+        if (!writer) std::_Exit(3);
+        char path[] = "/tmp/ceilpose-sigbus-XXXXXX";
+        const int fd = ::mkstemp(path);
+        ::unlink(path);
+        if (fd < 0 || ::ftruncate(fd, 4096) != 0) std::_Exit(4);
+        auto* p = static_cast<volatile char*>(
+            ::mmap(nullptr, 4096, PROT_READ | PROT_WRITE, MAP_SHARED, fd, 0));
+        if (::ftruncate(fd, 0) != 0) std::_Exit(5);
+        p[0] = 1;  // past the end of the file
+        std::_Exit(0);
+      },
+      dies_of_sigbus, "");
 }
 
 // A reader in another time namespace (its CLOCK_MONOTONIC behind the
