@@ -29,9 +29,8 @@ inline const char* check_source(const std::string& s) {
 }
 
 inline const char* check_shm_name(const std::string& s) {
-  if (shm::valid_shm_name(s)) return nullptr;
-  return "a shared-memory name: '/' followed by 1-249 printable characters without '/' or space "
-         "(not '/.' or '/..')";
+  static const std::string expected = std::string("a shared-memory name: ") + shm::kShmNameRule;
+  return shm::valid_shm_name(s) ? nullptr : expected.c_str();
 }
 
 // Empty: the host name, made a ROS name (daemon/service.cpp).

@@ -13,10 +13,10 @@ namespace ceilpose::ctl {
 // Documented exit codes of ceilposectl (see --help and README).
 enum ExitCode : int {
   kExitOk = 0,
-  kExitFailure = 1,       // runtime error (I/O, device, DDS)
-  kExitUsage = 2,         // bad command line
-  kExitNoDaemon = 3,      // no daemon publishing, or its pose is stale
-  kExitBadInput = 4,      // malformed recording or configuration
+  kExitFailure = 1,   // runtime error (I/O, device, DDS)
+  kExitUsage = 2,     // bad command line
+  kExitNoDaemon = 3,  // no daemon publishing, or its pose is stale
+  kExitBadInput = 4,  // malformed recording or configuration
 };
 
 using CommandFactory = void (*)(CLI::App& app);

@@ -9,6 +9,7 @@
 
 #include "core/clock.h"
 #include "ctl/command_registry.h"
+#include "ctl/shm_option.h"
 #include "ipc/shm/pose_text.h"
 #include "ipc/shm/shm_pose_reader.h"
 
@@ -129,7 +130,7 @@ void add_pose_command(CLI::App& app) {
       "timestamp_ns (capture, CLOCK_MONOTONIC), with the filter vx_mps, vy_mps, yaw_rate_radps, "
       "and more, plus daemon and live. --at predicts the pose to now or MS ms from now with the "
       "filter's motion (exit 1 beyond the daemon's filter.predict_horizon_ms).");
-  cmd->add_option("--shm", args->shm, "shared-memory segment name")->capture_default_str();
+  add_shm_option(cmd, &args->shm);
   cmd->add_flag("--json", args->json, "one JSON object for scripts");
   cmd->add_option("--stale-ms", args->stale_ms,
                   "a pose or heartbeat older than this is stale"

@@ -10,6 +10,7 @@
 #include "core/clock.h"
 #include "core/refusal.h"
 #include "ctl/command_registry.h"
+#include "ctl/shm_option.h"
 #include "ipc/shm/pose_text.h"
 #include "ipc/shm/shm_pose_reader.h"
 
@@ -177,7 +178,7 @@ void add_status_command(CLI::App& app) {
       "(--json: an object \"refusals\" of reason -> count, \"localized\" the frames with a pose). "
       "Exit 0 when the daemon is live "
       "(or starting), 3 when none is publishing or it stopped, died or is stale.");
-  cmd->add_option("--shm", args->shm, "shared-memory segment name")->capture_default_str();
+  add_shm_option(cmd, &args->shm);
   cmd->add_flag("--json", args->json, "one JSON object for scripts");
   cmd->add_option("--stale-ms", args->stale_ms,
                   "a heartbeat older than this is stale"

@@ -15,6 +15,7 @@
 #include "config/cli_checks.h"
 #include "core/clock.h"
 #include "ctl/command_registry.h"
+#include "ctl/shm_option.h"
 #include "ipc/shm/pose_text.h"
 #include "ipc/shm/shm_pose_reader.h"
 
@@ -116,7 +117,7 @@ void add_watch_command(CLI::App& app) {
       "one JSON object per line with --json (seq, valid, x_m, y_m, yaw_rad, mode, markers, "
       "timestamp_ns, ...). Waits for the daemon if it is not running and re-attaches when it "
       "restarts. Exit 0 after --count poses.");
-  cmd->add_option("--shm", args->shm, "shared-memory segment name")->capture_default_str();
+  add_shm_option(cmd, &args->shm);
   cmd->add_flag("--json", args->json, "JSON lines for machines");
   cmd->add_option("--count", args->count, "stop after N poses (0: until interrupted)")
       ->capture_default_str()

@@ -36,8 +36,11 @@ enum class ShmErrc : int {
 // Stores `code` in *out (if given) and returns the error with `message`.
 Error fail(ShmErrc* out, ShmErrc code, std::string message);
 
-// A POSIX shm name: "/" then 1..250 characters without another "/".
+// A POSIX shm name: "/" then 1..249 printable characters without another "/"
+// (room is left for the "-wake" suffix); kShmNameRule says so in messages.
 bool valid_shm_name(const std::string& name);
+inline constexpr const char* kShmNameRule =
+    "'/' followed by 1-249 printable characters without '/' or space (not '/.' or '/..')";
 std::string wake_segment_name(const std::string& name);
 
 // What a mapping does when the file under it shrinks (truncate(1) by the

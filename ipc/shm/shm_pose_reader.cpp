@@ -9,6 +9,7 @@
 
 #include <algorithm>
 #include <cerrno>
+#include <cstdio>
 #include <limits>
 
 #include "core/clock.h"
@@ -135,6 +136,35 @@ struct OpenedSegment {
   struct stat st {};
 };
 
+// A writer sizes and fills a new segment within milliseconds of creating it;
+// one still empty or without a header after this long is not being created
+// by anyone (another program's file, or a writer that died creating it).
+constexpr int64_t kCreationGraceNs = 2'000'000'000;
+
+// Seconds since the segment's size last changed (ftruncate sets the mtime).
+double seconds_since_sized(const struct stat& st) {
+  const int64_t sized_ns = int64_t{st.st_mtim.tv_sec} * 1'000'000'000 + st.st_mtim.tv_nsec;
+  return static_cast<double>(realtime_ns() - sized_ns) * 1e-9;
+}
+
+// kNotReady while a writer could still be creating the segment, kBadMagic
+// once none can be.
+Error not_ready_or_foreign(const std::string& name, const struct stat& st, const std::string& what,
+                           ShmErrc* code) {
+  const double age_s = seconds_since_sized(st);
+  if (age_s * 1e9 < static_cast<double>(kCreationGraceNs)) {
+    return fail(code, ShmErrc::kNotReady,
+                "shm segment " + name + " is " + what + ": its writer is still creating it");
+  }
+  char age[32];
+  std::snprintf(age, sizeof age, "%.0f s", age_s);
+  return fail(code, ShmErrc::kBadMagic,
+              "shm segment " + name + " is " + what + " " + age +
+                  " after it was sized: not a ceilpose segment (another program's file, or a "
+                  "writer that died creating it); remove /dev/shm" +
+                  name + " (as its owner or root)");
+}
+
 // Opens and maps the pose segment read-only, refusing one too small to hold
 // a header.
 Result<OpenedSegment> open_pose_segment(const std::string& name, ShmErrc* code) {
@@ -160,10 +190,7 @@ Result<OpenedSegment> open_pose_segment(const std::string& name, ShmErrc* code) 
                 "cannot stat shm segment " + name + ": " + shm::errno_text(e));
   }
   const auto size_bytes = static_cast<size_t>(out.st.st_size);
-  if (size_bytes == 0) {
-    return fail(code, ShmErrc::kNotReady,
-                "shm segment " + name + " is empty: its writer is still creating it");
-  }
+  if (size_bytes == 0) return not_ready_or_foreign(name, out.st, "empty", code);
   constexpr size_t kIdentityBytes = offsetof(shm::SegmentHeader, header_size);
   if (size_bytes < kIdentityBytes) {
     return fail(code, ShmErrc::kBadSize,
@@ -185,13 +212,11 @@ Result<OpenedSegment> open_pose_segment(const std::string& name, ShmErrc* code) 
 
 // The header must be complete (magic), ours (magic), of our ABI and of the
 // sizes this ABI lays out.
-Result<void> check_header(const Segment& seg, size_t size_bytes, const std::string& name,
+Result<void> check_header(const Segment& seg, const struct stat& st, const std::string& name,
                           ShmErrc* code) {
+  const auto size_bytes = static_cast<size_t>(st.st_size);
   const uint64_t magic = seg.header.magic.load(std::memory_order_acquire);
-  if (magic == 0) {
-    return fail(code, ShmErrc::kNotReady,
-                "shm segment " + name + " is not initialized yet: its writer is starting");
-  }
+  if (magic == 0) return not_ready_or_foreign(name, st, "without a header", code);
   if (magic != shm::kMagic) {
     return fail(code, ShmErrc::kBadMagic,
                 "shm segment " + name + " is not a ceilpose pose segment (bad magic)");
@@ -271,14 +296,12 @@ Result<ShmPoseReader> ShmPoseReader::open(const std::string& name, ShmErrc* code
   if (code != nullptr) *code = ShmErrc::kOk;
   if (!shm::valid_shm_name(name)) {
     return fail(code, ShmErrc::kInvalidArgument,
-                "invalid shm segment name '" + name +
-                    "': must be '/' followed by 1-249 characters without '/'");
+                "invalid shm segment name '" + name + "': must be " + shm::kShmNameRule);
   }
   auto pose = open_pose_segment(name, code);
   if (!pose) return pose.error();
   const auto* seg = static_cast<const Segment*>(pose->mapping.get());
-  if (auto ok = check_header(*seg, static_cast<size_t>(pose->st.st_size), name, code); !ok)
-    return ok.error();
+  if (auto ok = check_header(*seg, pose->st, name, code); !ok) return ok.error();
   auto wake = open_wake_segment(name, seg->header.generation, seg->header.wake_inode, code);
   if (!wake) return wake.error();
 

@@ -237,8 +237,7 @@ Result<void> check_options(const ShmOptions& options, ShmErrc* code) {
   const std::string& name = options.name;
   if (!shm::valid_shm_name(name)) {
     return fail(code, ShmErrc::kInvalidArgument,
-                "invalid shm segment name '" + name +
-                    "': must be '/' followed by 1-249 characters without '/'");
+                "invalid shm segment name '" + name + "': must be " + shm::kShmNameRule);
   }
   if (options.heartbeat_period_ms < 0) {
     return fail(code, ShmErrc::kInvalidArgument,

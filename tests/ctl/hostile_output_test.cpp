@@ -71,5 +71,18 @@ TEST_F(HostileOutput, CountsAndDurationsThatNeverEndAreUsageErrors) {
       << fleet.err;
 }
 
+// A malformed --shm used to exit 1 (a runtime failure) from the reader.
+TEST_F(HostileOutput, AMalformedShmNameIsAUsageError) {
+  for (const char* command : {"pose", "watch", "status"}) {
+    for (const char* shm : {"ceilpose", "/a b", "/..", ""}) {
+      const CommandOutput r = run_ceilposectl({command, "--shm", shm});
+      EXPECT_EQ(r.exit_code, kExitUsage) << command << " --shm '" << shm << "': " << r.err;
+      EXPECT_NE(r.err.find("--shm: must be '/' followed by 1-249 printable characters"),
+                std::string::npos)
+          << command << ": " << r.err;
+    }
+  }
+}
+
 }  // namespace
 }  // namespace ceilpose::test

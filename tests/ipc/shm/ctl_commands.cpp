@@ -1,6 +1,8 @@
 // ceilposectl status / pose / watch run as separate processes against a
 // writer in the test process (SPEC §7 names, flags, JSON fields, exit codes).
+#include <fcntl.h>
 #include <gtest/gtest.h>
+#include <unistd.h>
 
 #include <atomic>
 #include <chrono>
@@ -289,6 +291,36 @@ TEST_F(CtlCommands, WatchJsonStreamsCountPosesAsTheyArePublished) {
   EXPECT_EQ(rc, 0) << err_;
   EXPECT_EQ(count_lines(out_), 3u) << out_;
   EXPECT_TRUE(contains(out_, "\"markers\":9")) << out_;
+}
+
+// Issue 15: pose, status and watch into /dev/full used to exit 0 with their
+// output lost.
+TEST_F(CtlCommands, PoseStatusAndWatchIntoAFullDeviceFailSayingSo) {
+  ASSERT_NO_FATAL_FAILURE(start());
+  std::atomic<bool> finished{false};
+  std::thread publisher([&] {
+    for (int64_t k = 1; !finished.load() && k < 10'000; ++k) {
+      writer().publish(sample_pose(k));
+      std::this_thread::sleep_for(std::chrono::milliseconds(20));
+    }
+  });
+  for (const std::vector<std::string>& args :
+       {std::vector<std::string>{"pose", "--shm", name(), "--stale-ms", kLenientStaleMs},
+        {"pose", "--shm", name(), "--json", "--stale-ms", kLenientStaleMs},
+        {"status", "--shm", name(), "--stale-ms", kLenientStaleMs},
+        {"status", "--shm", name(), "--json", "--stale-ms", kLenientStaleMs},
+        {"watch", "--shm", name(), "--count", "3"},
+        {"watch", "--shm", name(), "--json", "--count", "3"}}) {
+    const int full = ::open("/dev/full", O_WRONLY | O_CLOEXEC);
+    ASSERT_GE(full, 0);
+    const test::RunOutput r = test::run_to_end(ctl(args), kRunTimeoutMs, full);
+    ::close(full);
+    EXPECT_EQ(r.exit_code, 1) << args[0] << ": " << r.err;
+    EXPECT_TRUE(contains(r.err, "cannot write to stdout: No space left on device"))
+        << args[0] << ": " << r.err;
+  }
+  finished.store(true);
+  publisher.join();
 }
 
 TEST_F(CtlCommands, WatchWaitsForDaemonThatStartsLater) {

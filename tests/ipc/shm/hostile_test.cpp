@@ -207,6 +207,37 @@ TEST(ShmSigbusGuard, AFaultOutsideEverySegmentStillKills) {
       dies_of_sigbus, "");
 }
 
+// A file of the right size with no header (zeros: another program's, or a
+// writer that died creating it) used to be "not initialized yet: its writer
+// is starting" forever, and watch waited on it for good.
+TEST_F(ShmHostile, AFileWithoutAHeaderIsForeignOnceNoWriterCanBeCreatingIt) {
+  const int fd = ::shm_open(name().c_str(), O_RDWR | O_CREAT | O_EXCL | O_CLOEXEC, 0640);
+  ASSERT_GE(fd, 0);
+  ASSERT_EQ(::ftruncate(fd, sizeof(shm::Segment)), 0);
+  ShmErrc code = ShmErrc::kOk;
+  auto fresh = ShmPoseReader::open(name(), &code);
+  EXPECT_FALSE(fresh);
+  EXPECT_EQ(code, ShmErrc::kNotReady) << "just sized: a writer may be filling it in";
+  const timespec ten_s_ago[2] = {{::time(nullptr) - 10, 0}, {::time(nullptr) - 10, 0}};
+  ASSERT_EQ(::futimens(fd, ten_s_ago), 0);
+  auto old = ShmPoseReader::open(name(), &code);
+  ASSERT_FALSE(old);
+  EXPECT_EQ(code, ShmErrc::kBadMagic);
+  EXPECT_NE(old.error().message.find("shm segment " + name() + " is without a header 1"),
+            std::string::npos)
+      << old.error().message;
+  EXPECT_NE(old.error().message.find(" s after it was sized: not a ceilpose segment"),
+            std::string::npos)
+      << old.error().message;
+  EXPECT_NE(old.error().message.find("remove /dev/shm" + name()), std::string::npos);
+  ASSERT_EQ(::ftruncate(fd, 0), 0);
+  ASSERT_EQ(::futimens(fd, ten_s_ago), 0);
+  auto empty = ShmPoseReader::open(name(), &code);
+  ASSERT_FALSE(empty);
+  EXPECT_EQ(code, ShmErrc::kBadMagic) << empty.error().message;
+  ::close(fd);
+}
+
 // A reader in another time namespace (its CLOCK_MONOTONIC behind the
 // writer's) used to count the negative age of every heartbeat as live.
 TEST_F(ShmHostile, AHeartbeatFromTheFutureIsNotLive) {
