@@ -92,6 +92,9 @@ Result<CameraIntrinsics> read_camera_info_file(const std::string& path) {
   auto d = matrix(path, *root, "distortion_coefficients", 1, 5);
   if (!d) return d.error();
   for (size_t c = 0; c < 5; ++c) k.distortion[c] = (*d)[c];
+  if (const std::string lens = distortion_problem(k); !lens.empty())
+    return make_error(where(path, (*root)["distortion_coefficients"]) +
+                      ": distortion_coefficients: " + lens);
   return k;
 }
 

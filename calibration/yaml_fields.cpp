@@ -4,6 +4,7 @@
 #include <cstring>
 
 #include "core/text_file.h"
+#include "core/yaml_duplicate_keys.h"
 
 namespace ceilpose::calibration_detail {
 
@@ -24,6 +25,7 @@ Result<YAML::Node> load_yaml_mapping(const std::string& path, const char* what) 
     return make_error(path + ": YAML error: " + e.what());
   }
   if (!root.IsMap()) return make_error(path + ":1: expected a YAML mapping (a " + what + ")");
+  if (auto unique = check_no_duplicate_keys(root, path); !unique) return unique.error();
   return root;
 }
 

@@ -285,6 +285,8 @@ void check_cross_keys(Reader& r, const ServiceConfig& c) {
             "expected at most " + std::to_string(kMaxImagePixels) + " pixels (camera.width x " +
                 "camera.height), found " + std::to_string(k.width) + "x" +
                 std::to_string(k.height));
+  const std::string lens = distortion_problem(k);
+  r.require(lens.empty(), "camera.distortion", "expected a lens this camera can have: " + lens);
   // Each window must be a window: a minimum above its maximum accepts no
   // rectangle, and the daemon would never have a fix.
   const DetectorParams& d = p.detector;

@@ -1,6 +1,7 @@
 #include "core/camera_model.h"
 
 #include <cmath>
+#include <cstdio>
 
 namespace ceilpose {
 
@@ -92,6 +93,36 @@ void undistort_pixel(const CameraIntrinsics& k, double u_px, double v_px, double
   }
   *x_n = x;
   *y_n = y;
+}
+
+std::string distortion_problem(const CameraIntrinsics& k) {
+  if (!k.has_distortion()) return {};
+  // The border of the image's central half, 16 samples a side. Not the
+  // image's own border: a very wide lens whose corners the fixed-point
+  // inverse cannot reach still localizes everywhere else.
+  constexpr int kSamplesPerSide = 16;
+  const double w = 0.5 * (k.width - 1), h = 0.5 * (k.height - 1);
+  const double u0 = 0.25 * (k.width - 1), v0 = 0.25 * (k.height - 1);
+  for (int side = 0; side < 4; ++side) {
+    for (int i = 0; i <= kSamplesPerSide; ++i) {
+      const double t = static_cast<double>(i) / kSamplesPerSide;
+      const double u = u0 + (side == 0 ? t * w : side == 1 ? w : side == 2 ? (1 - t) * w : 0.0);
+      const double v = v0 + (side == 0 ? 0.0 : side == 1 ? t * h : side == 2 ? h : (1 - t) * h);
+      double x = 0, y = 0, xd = 0, yd = 0;
+      undistort_pixel(k, u, v, &x, &y);
+      distort_normalized(k, x, y, &xd, &yd);
+      const double miss_px = std::hypot(xd * k.fx + k.cx - u, yd * k.fy + k.cy - v);
+      if (!(miss_px <= kMaxDistortionRoundTripPx)) {
+        char text[160];
+        std::snprintf(text, sizeof text,
+                      "the distortion cannot be inverted at pixel (%.0f, %.0f) (round trip off "
+                      "by %.3g px; at most %.1f px)",
+                      u, v, miss_px, kMaxDistortionRoundTripPx);
+        return text;
+      }
+    }
+  }
+  return {};
 }
 
 }  // namespace ceilpose

@@ -3,6 +3,7 @@
 // camera mounted on the robot looking up, row 0 towards the robot's forward.
 #include <array>
 #include <cmath>
+#include <string>
 
 #include "core/pose.h"
 
@@ -99,5 +100,14 @@ bool project_world_point(const CameraIntrinsics& k, const CameraPose& pose, cons
 // Pixel to undistorted normalized coordinates (iterative inverse of plumb_bob,
 // as cv::undistortPoints does).
 void undistort_pixel(const CameraIntrinsics& k, double u_px, double v_px, double* x_n, double* y_n);
+
+// Pixels of the image's central half whose undistortion, distorted back,
+// misses them by more than this cannot be localized: the coefficients
+// describe no lens this image could come from (a typo, 1e300).
+inline constexpr double kMaxDistortionRoundTripPx = 0.5;
+// Empty when the distortion can be inverted over the image's central half,
+// else what fails, naming the pixel: "the distortion cannot be inverted at
+// pixel (160, 120) (round trip off by 31.2 px; at most 0.5 px)".
+std::string distortion_problem(const CameraIntrinsics& k);
 
 }  // namespace ceilpose

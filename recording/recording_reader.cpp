@@ -18,6 +18,7 @@
 #include <string_view>
 
 #include "core/text_file.h"
+#include "core/yaml_duplicate_keys.h"
 #include "recording/frame_file.h"
 #include "recording/recording_format.h"
 
@@ -113,6 +114,7 @@ Result<RecordingCamera> parse_yaml(const std::string& path) {
   if (!root.IsMap()) {
     return make_error(path + ":1: expected a mapping with keys format, version, camera");
   }
+  if (auto unique = check_no_duplicate_keys(root, path); !unique) return unique.error();
   auto format = yaml_scalar<std::string>(root, "", "format", path, "a string");
   if (!format) return format.error();
   if (*format != fmt::kFormat) {
@@ -177,6 +179,9 @@ Result<RecordingCamera> parse_yaml(const std::string& path) {
       }
       k.distortion[static_cast<size_t>(c)] = v;
     }
+    if (const std::string lens = distortion_problem(k); !lens.empty())
+      return make_error(path + ":" + std::to_string(line_of(dist)) +
+                        ": camera.distortion: " + lens);
   }
   // readout_ms is optional (SPEC §3: absent means a global shutter).
   if (const YAML::Node readout = cam["readout_ms"]; readout.IsDefined() && !readout.IsNull()) {
@@ -425,6 +430,11 @@ Result<RecordingReader> RecordingReader::open(const std::string& dir) {
       if (blank_line == 0) blank_line = line_no;
       continue;
     }
+    // A NUL would silently end the field it is in (a file name, a number).
+    if (const size_t nul = line.find('\0'); nul != std::string_view::npos) {
+      return make_error(where + ": a NUL byte at character " + std::to_string(nul + 1) +
+                        " (binary data in a text file)");
+    }
     if (blank_line != 0) {
       return make_error(csv_path + ":" + std::to_string(blank_line) +
                         ": empty line before the end of the file");
@@ -448,6 +458,11 @@ Result<RecordingReader> RecordingReader::open(const std::string& dir) {
     r.frame_paths_.push_back(frame_path);
   }
   if (!header_seen) return make_error(csv_path + ":1: empty file, expected the header line");
+  // One answer for every command (inspect, locate, evaluate, replay): a
+  // recording without a frame is not one (docs/decisions.md).
+  if (r.rows_.empty())
+    return make_error(csv_path + ":" + std::to_string(line_no) +
+                      ": no frames, only the header (a recording holds at least one frame)");
   return r;
 }
 

@@ -112,6 +112,15 @@ TEST(ConfigLoader, DuplicateKeyIsAnError) {
               HasSubstr("test.yaml:3: camera.fx: key appears twice"));
 }
 
+// Issue 15: 1e300 was accepted and every frame then came out invalid.
+TEST(ConfigLoader, ADistortionNoLensCanHaveIsAnError) {
+  EXPECT_THAT(error_of("camera:\n  distortion: [1e300, 0, 0, 0, 0]\n"),
+              HasSubstr("camera.distortion: expected a lens this camera can have: the distortion "
+                        "cannot be inverted at pixel (160, 120)"));
+  EXPECT_TRUE(load_config_string("camera:\n  distortion: [-0.35, 0.12, 0, 0, -0.015]\n", "t").ok())
+      << "a wide lens is a lens";
+}
+
 TEST(ConfigLoader, TheCaptureSizeIsTheCalibrationsNotASecondKey) {
   // The frame size is camera.width x camera.height; a second key could only
   // contradict it.

@@ -192,6 +192,17 @@ std::vector<MalformedCase> make_cases() {
                png,
                [=](const std::string& d) { replace_line(yaml(d), 7, "  fy: -530"); },
                {"recording.yaml:7", "'camera.fy'", "positive"}});
+  c.push_back({"DuplicateCameraKey",
+               png,
+               [=](const std::string& d) { replace_line(yaml(d), 7, "  fx: 600"); },
+               {"recording.yaml:7", "key 'camera.fx' appears twice"}});
+  c.push_back(
+      {"DistortionNoLensCanHave",
+       png,
+       [=](const std::string& d) {
+         replace_line(yaml(d), 10, "  distortion: [1e300, 0, 0, 0, 0]");
+       },
+       {"recording.yaml:10", "camera.distortion: the distortion cannot be inverted at pixel"}});
   c.push_back({"DistortionWithTwoCoefficients",
                png,
                [=](const std::string& d) { replace_line(yaml(d), 10, "  distortion: [0.1, 0]"); },
@@ -228,6 +239,19 @@ std::vector<MalformedCase> make_cases() {
                png,
                [=](const std::string& d) { fs::remove(csv(d)); },
                {"frames.csv", "missing"}});
+  c.push_back({"HeaderOnlyNoFrames",
+               png,
+               [=](const std::string& d) {
+                 write_text_file(csv(d), "index,timestamp_ns,file,gt_x_m,gt_y_m,gt_yaw_rad\n");
+               },
+               {"frames.csv:1", "no frames, only the header"}});
+  c.push_back({"NulByteInAFileName",
+               png,
+               [=](const std::string& d) {
+                 const char row[] = "0,1000000000,frames/000000.png\0.txt,0.5,0.5,0";
+                 replace_line(csv(d), 2, std::string(row, sizeof row - 1));
+               },
+               {"frames.csv:2", "a NUL byte at character 31"}});
   c.push_back({"EmptyFramesCsv",
                png,
                [=](const std::string& d) { write_text_file(csv(d), ""); },
