@@ -60,10 +60,31 @@ int run_watch(const WatchArgs& args) {
   uint64_t last_seq = 0;
   uint64_t printed = 0;
   std::string reported;  // the last liveness problem told to the user
+  uint64_t skipped = 0;  // poses published but never printed (seq gaps)
+  int busy_in_a_row = 0;
   while (args.count == 0 || printed < args.count) {
     PoseRecord pose;
     const WaitResult r = reader.wait_next(last_seq, kWaitSliceMs, &pose);
     if (r == WaitResult::kPose) {
+      busy_in_a_row = 0;
+      if (pose.seq == last_seq) {  // a header written over points at the pose already printed
+        std::this_thread::sleep_for(std::chrono::milliseconds(1));
+        continue;
+      }
+      if (last_seq != 0 && pose.seq < last_seq) {
+        note("pose sequence on " + args.shm + " went back from " + std::to_string(last_seq) +
+             " to " + std::to_string(pose.seq) +
+             " without a restart: something other than ceilposed wrote into the segment");
+      } else if (last_seq != 0 && pose.seq > last_seq + 1) {
+        // Said when it starts and then every 100 lost, not per pose.
+        const uint64_t gap = pose.seq - last_seq - 1;
+        if (skipped == 0 || skipped / 100 != (skipped + gap) / 100) {
+          note("skipped " + std::to_string(skipped + gap) + " pose(s) so far (last gap: seq " +
+               std::to_string(last_seq + 1) + " to " + std::to_string(pose.seq - 1) +
+               "): poses were published faster than they were printed");
+        }
+        skipped += gap;
+      }
       const int64_t now_ns = monotonic_ns();
       if (args.json) {
         std::printf("%s\n", pose_json(pose, now_ns).c_str());
@@ -83,7 +104,17 @@ int run_watch(const WatchArgs& args) {
       reported.clear();
       continue;
     }
-    if (r == WaitResult::kBusy) continue;
+    if (r == WaitResult::kBusy) {
+      // The writer never holds a slot this long; garbage over the segment
+      // does, until the writer's next publish overwrites it.
+      if (++busy_in_a_row == 10) {
+        note("the latest pose on " + args.shm +
+             " stays unreadable (torn): something wrote over the segment; waiting for the "
+             "daemon's next pose");
+      }
+      std::this_thread::sleep_for(std::chrono::milliseconds(1));
+      continue;
+    }
     const Liveness liveness = reader.liveness(args.stale_ms);
     if (liveness == Liveness::kRestarted) {
       shm::ShmErrc reattach_code = shm::ShmErrc::kOk;

@@ -119,6 +119,7 @@ struct ShmPoseReader::Impl {
   WakeSegment* wake = nullptr;
   dev_t dev = 0;
   ino_t ino = 0;
+  uint64_t seen_seq = 0;  // the newest latest_seq wait_next saw
 
   const shm::SegmentHeader& header() const { return seg->header; }
   WriterState state() const {
@@ -379,9 +380,18 @@ WaitResult ShmPoseReader::wait_next(uint64_t after_seq, int timeout_ms, PoseReco
   auto take = [&]() {
     return read_latest(out) == ReadResult::kOk ? WaitResult::kPose : WaitResult::kBusy;
   };
+  // A pose newer than after_seq, or a sequence that went back below what
+  // this reader saw (something wrote over the segment): waiting for it to
+  // pass the old number again would skip every pose in between, silently.
+  auto arrived = [&]() {
+    const uint64_t s = r.latest_seq();
+    const bool went_back = s < r.seen_seq;
+    r.seen_seq = s;
+    return went_back || s > after_seq;
+  };
   for (;;) {
     if (lost()) return WaitResult::kWriterDead;  // liveness() says kRestarted: re-open
-    if (r.latest_seq() > after_seq) return take();
+    if (arrived()) return take();
     if (r.state() == WriterState::kStopped) return WaitResult::kStopped;
     // Register, then sample the futex word, then re-check: the writer stores
     // the word and then reads `waiters` (both seq_cst), so either it sees us
@@ -390,7 +400,8 @@ WaitResult ShmPoseReader::wait_next(uint64_t after_seq, int timeout_ms, PoseReco
     const uint32_t word = h.wake_seq.load(std::memory_order_seq_cst);
     int rc = 0;
     bool timed_out = false;
-    if (r.latest_seq() <= after_seq && r.state() != WriterState::kStopped) {
+    const bool ready = arrived();
+    if (!ready && r.state() != WriterState::kStopped) {
       const int64_t remaining_ns = deadline_ns - monotonic_ns();
       if (remaining_ns <= 0) {
         timed_out = true;
@@ -400,7 +411,7 @@ WaitResult ShmPoseReader::wait_next(uint64_t after_seq, int timeout_ms, PoseReco
       }
     }
     r.wake->waiters.fetch_sub(1, std::memory_order_seq_cst);
-    if (r.latest_seq() > after_seq) return take();
+    if (ready || arrived()) return take();
     if (r.state() == WriterState::kStopped) return WaitResult::kStopped;
     if (timed_out) return WaitResult::kTimeout;
     if (rc == -ETIMEDOUT || rc == 0) {

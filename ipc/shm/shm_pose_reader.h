@@ -61,6 +61,8 @@ class ShmPoseReader {
   ReadResult read_latest(PoseRecord* out) const;
   // Blocks on the futex until a pose with seq > after_seq exists (returns the
   // newest), the writer stops or dies, or timeout_ms passes (< 0: forever).
+  // Also returns the newest pose when the sequence went back below one this
+  // reader saw (the segment was written over): its seq is then <= after_seq.
   WaitResult wait_next(uint64_t after_seq, int timeout_ms, PoseRecord* out);
   // stale_after_ms <= 0: the writer's own threshold (WriterInfo::stale_after_ms).
   Liveness liveness(int64_t stale_after_ms = 0) const;

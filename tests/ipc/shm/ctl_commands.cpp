@@ -2,17 +2,20 @@
 // writer in the test process (SPEC §7 names, flags, JSON fields, exit codes).
 #include <fcntl.h>
 #include <gtest/gtest.h>
+#include <sys/mman.h>
 #include <unistd.h>
 
 #include <atomic>
 #include <chrono>
 #include <cmath>
 #include <cstdlib>
+#include <cstring>
 #include <thread>
 #include <vector>
 
 #include "core/clock.h"
 #include "core/refusal.h"
+#include "ipc/shm/shm_layout.h"
 #include "ipc/shm/shm_pose_reader.h"
 #include "ipc/shm/shm_pose_writer.h"
 #include "shm_test_support.h"
@@ -358,6 +361,48 @@ TEST_F(CtlCommands, WatchReattachesAcrossDaemonRestart) {
   EXPECT_EQ(watch.wait_exit(kRunTimeoutMs), 0) << watch.error_output();
   EXPECT_EQ(count_lines(watch.output()), 2u) << watch.output();
   EXPECT_TRUE(contains(watch.output(), "\"timestamp_ns\":7")) << watch.output();
+}
+
+// Issue 15: garbage over a live segment (0x5a everywhere: a consistent
+// seqlock with seq 0x5a5a...) made an attached watch print one garbage pose
+// and then wait for the writer to pass 6.5e18: every later pose skipped,
+// silently. Now it follows the writer's sequence again and says why.
+TEST_F(CtlCommands, WatchFollowsTheWriterAfterGarbageOverTheSegmentAndSaysSo) {
+  ASSERT_NO_FATAL_FAILURE(start(/*heartbeat_period_ms=*/0));
+  writer().publish(sample_pose(1));
+  test::ChildProcess watch(ctl({"watch", "--shm", name(), "--json", "--count", "3"}),
+                           capturing_stderr());
+  ASSERT_TRUE(watch.started()) << watch.start_error();
+  ASSERT_TRUE(contains(watch.read_until("\"seq\":1,", kRunTimeoutMs), "\"seq\":1,"))
+      << watch.error_output();
+  {
+    const int fd = ::shm_open(name().c_str(), O_RDWR | O_CLOEXEC, 0);
+    ASSERT_GE(fd, 0);
+    void* p = ::mmap(nullptr, sizeof(shm::Segment), PROT_READ | PROT_WRITE, MAP_SHARED, fd, 0);
+    ::close(fd);
+    ASSERT_NE(p, MAP_FAILED);
+    std::memset(p, 0x5a, sizeof(shm::Segment));
+    ::munmap(p, sizeof(shm::Segment));
+  }
+  // Longer than the watch's 250 ms liveness slice: it wakes and reads the garbage.
+  std::this_thread::sleep_for(std::chrono::milliseconds(600));
+  writer().heartbeat();  // restores the header's identity
+  std::atomic<bool> finished{false};
+  std::thread publisher([&] {
+    for (int64_t k = 2; !finished.load() && k < 10'000; ++k) {
+      std::this_thread::sleep_for(std::chrono::milliseconds(20));
+      writer().publish(sample_pose(k));
+    }
+  });
+  const int rc = watch.wait_exit(kRunTimeoutMs);
+  finished.store(true);
+  publisher.join();
+  EXPECT_EQ(rc, 0) << watch.error_output();
+  EXPECT_TRUE(contains(watch.error_output(), "went back from"))
+      << watch.error_output() << watch.output();
+  EXPECT_TRUE(contains(watch.error_output(), "something other than ceilposed wrote into"));
+  EXPECT_TRUE(contains(watch.output(), "\"seq\":2,") || contains(watch.output(), "\"seq\":3,"))
+      << "the writer's own poses again: " << watch.output();
 }
 
 TEST_F(CtlCommands, WatchTablePrintsHeaderAndRows) {
