@@ -41,6 +41,11 @@ void DdsPoseSink::publish_status(const ServiceStatus& s) {
   ds.latency_max_us = static_cast<uint32_t>(s.latency.max_us);
   ds.refusals = s.refusals;
   if (!publisher_->publish_status(ds)) failures_.fetch_add(1, std::memory_order_relaxed);
+  if (auto others = publisher_->other_pose_writers(); others) {
+    other_pose_writers_.store(*others, std::memory_order_relaxed);
+  } else {
+    failures_.fetch_add(1, std::memory_order_relaxed);
+  }
 }
 
 }  // namespace ceilpose::daemon

@@ -21,11 +21,15 @@ class DdsPoseSink final : public PublishingSink {
   void publish_status(const ServiceStatus& status) override;
   int64_t status_period_ns() const override { return status_period_ns_; }
   uint64_t failures() const override { return failures_.load(std::memory_order_relaxed); }
+  // Other processes' writers on this robot's pose topic, as of the last
+  // status (the control thread warns; see DdsPosePublisher).
+  size_t other_pose_writers() const { return other_pose_writers_.load(std::memory_order_relaxed); }
 
  private:
   DdsPosePublisher* publisher_;
   int64_t status_period_ns_;
   std::atomic<uint64_t> failures_{0};
+  std::atomic<size_t> other_pose_writers_{0};
 };
 
 }  // namespace ceilpose::daemon

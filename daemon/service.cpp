@@ -275,6 +275,7 @@ void Service::loop() {
   PosePrinter printer(start_ns_);
   uint64_t header_repairs = 0;
   uint64_t truncations = 0;
+  size_t other_pose_writers = 0;
   bool stalled_reported = false;
 
   for (;;) {
@@ -319,6 +320,21 @@ void Service::loop() {
     }
     if (now >= next_status) {
       next_status = now + status_period_ns;
+#ifdef CEILPOSE_DAEMON_HAVE_DDS
+      if (dds_sink_ && dds_sink_->other_pose_writers() != other_pose_writers) {
+        const size_t before = other_pose_writers;
+        other_pose_writers = dds_sink_->other_pose_writers();
+        if (other_pose_writers > 0) {
+          spdlog::warn(
+              "DDS: {} writer(s) in another process also publish {} on domain {}: two robots "
+              "named '{}', or ceilposed started twice? Subscribers see their poses interleaved; "
+              "give each robot its own --robot / dds.robot_name",
+              other_pose_writers, dds_->pose_topic(), dds_->domain_id(), dds_->robot());
+        } else if (before > 0) {
+          spdlog::info("DDS: {} has no other writer any more", dds_->pose_topic());
+        }
+      }
+#endif
       if (shm_ && shm_->truncations() != truncations) {
         truncations = shm_->truncations();
         spdlog::error(

@@ -1,5 +1,9 @@
 #include "ipc/dds/dds_pose_publisher.h"
 
+#include <algorithm>
+#include <array>
+#include <cstring>
+
 #include "ipc/dds/dds_error.h"
 #include "ipc/dds/dds_qos.h"
 
@@ -64,7 +68,50 @@ Result<DdsPosePublisher> DdsPosePublisher::create(const DdsOptions& options) {
       create_writer(pub.participant_, &nav_msgs_msg_dds__Odometry__desc, pub.odom_topic_, options);
   if (!odom_writer) return odom_writer.error();
   pub.odom_writer_ = *odom_writer;
+  pub.publication_reader_ = dds_create_reader(pub.participant_.handle(),
+                                              DDS_BUILTIN_TOPIC_DCPSPUBLICATION, nullptr, nullptr);
+  if (pub.publication_reader_ < 0) {
+    return dds_error(
+        "cannot read DCPSPublication on DDS domain " + std::to_string(pub.participant_.domain_id()),
+        pub.publication_reader_);
+  }
+  if (const dds_return_t rc = dds_get_guid(pub.participant_.handle(), &pub.own_guid_);
+      rc != DDS_RETCODE_OK) {
+    return dds_error("cannot get the DDS participant's GUID", rc);
+  }
   return pub;
+}
+
+Result<size_t> DdsPosePublisher::other_pose_writers() {
+  if (!participant_.valid()) return make_error("DDS publisher of " + robot_ + " was disposed");
+  constexpr int kBatch = 16;
+  std::array<void*, kBatch> samples{};
+  std::array<dds_sample_info_t, kBatch> infos{};
+  for (;;) {
+    samples.fill(nullptr);  // Cyclone lends its buffers
+    const dds_return_t n =
+        dds_take(publication_reader_, samples.data(), infos.data(), kBatch, kBatch);
+    if (n < 0) return dds_error("cannot take DCPSPublication samples", n);
+    if (n == 0) break;
+    for (dds_return_t k = 0; k < n; ++k) {
+      const dds_instance_handle_t handle = infos[k].instance_handle;
+      auto known = std::find(other_writers_.begin(), other_writers_.end(), handle);
+      if (infos[k].instance_state != DDS_IST_ALIVE) {
+        if (known != other_writers_.end()) other_writers_.erase(known);
+        continue;
+      }
+      if (!infos[k].valid_data || known != other_writers_.end()) continue;
+      const auto* endpoint = static_cast<const dds_builtintopic_endpoint_t*>(samples[k]);
+      const bool ours = std::memcmp(&endpoint->participant_key, &own_guid_, sizeof own_guid_) == 0;
+      if (!ours && endpoint->topic_name != nullptr && pose_topic_ == endpoint->topic_name)
+        other_writers_.push_back(handle);
+    }
+    if (const dds_return_t rc = dds_return_loan(publication_reader_, samples.data(), n);
+        rc != DDS_RETCODE_OK) {
+      return dds_error("cannot return DCPSPublication samples", rc);
+    }
+  }
+  return other_writers_.size();
 }
 
 Result<void> DdsPosePublisher::publish(const DdsPose& pose) {
@@ -98,6 +145,8 @@ void DdsPosePublisher::dispose() {
   pose_writer_ = 0;
   status_writer_ = 0;
   odom_writer_ = 0;
+  publication_reader_ = 0;
+  other_writers_.clear();
 }
 
 }  // namespace ceilpose

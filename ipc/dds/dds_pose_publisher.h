@@ -12,6 +12,7 @@
 
 #include <cstdint>
 #include <string>
+#include <vector>
 
 #include "core/result.h"
 #include "ipc/dds/dds_messages.h"
@@ -46,6 +47,12 @@ class DdsPosePublisher {
   // process is the cheapest for discovery); 0 after dispose().
   dds_entity_t participant_handle() const { return participant_.handle(); }
   uint64_t published() const { return published_; }
+  // Writers of this robot's pose topic in other participants, from the
+  // domain's DCPSPublication: > 0 means another process publishes under the
+  // same robot name (two robots named alike, or a daemon started twice), and
+  // subscribers would see both robots' poses interleaved on one topic.
+  // Not per frame: it takes discovery samples (status period).
+  Result<size_t> other_pose_writers();
 
  private:
   DdsPosePublisher() = default;
@@ -59,6 +66,9 @@ class DdsPosePublisher {
   std::string status_topic_;
   std::string odom_topic_;
   uint64_t published_ = 0;
+  dds_entity_t publication_reader_ = 0;  // DCPSPublication, child of participant_
+  dds_guid_t own_guid_{};
+  std::vector<dds_instance_handle_t> other_writers_;
 };
 
 }  // namespace ceilpose

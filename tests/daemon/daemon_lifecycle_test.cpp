@@ -18,6 +18,7 @@
 #include "ipc/shm/shm_pose_writer.h"
 #include "tests/daemon/daemon_process.h"
 #include "tests/daemon/stopped_thread.h"
+#include "tests/ipc/dds/dds_test_env.h"
 
 namespace ceilpose::test {
 namespace {
@@ -334,6 +335,36 @@ TEST_F(DaemonLifecycle, PublishesOnDdsAndDisposesOnSigterm) {
   ASSERT_TRUE(exit.has_value());
   EXPECT_EQ(exit->code, daemon::kExitOk) << dds_daemon.err();
   EXPECT_NE(dds_daemon.err().find("topic rt/testbot/pose"), std::string::npos) << dds_daemon.err();
+  EXPECT_EQ(dds_daemon.err().find("also publish"), std::string::npos)
+      << "its own writers are not another robot's: " << dds_daemon.err();
+}
+
+// Issue 15: two daemons publishing under one --robot interleaved their poses
+// on one topic and neither said a word.
+TEST_F(DaemonLifecycle, TwoDaemonsWithOneRobotNameOnDdsEachWarn) {
+  const std::string domain = std::to_string(unique_domain_id());
+  const std::string other_shm = unique_shm_name();
+  const std::map<std::string, std::string> env{{"CYCLONEDDS_URI", kLoopbackConfig}};
+  auto args = [&](const std::string& shm) {
+    return std::vector<std::string>{"--source", "synthetic", "--shm",   shm,
+                                    "--domain", domain,      "--robot", "twin"};
+  };
+  DaemonProcess first(args(shm_), env);
+  DaemonProcess second(args(other_shm), env);
+  const std::string warning = "writer(s) in another process also publish rt/twin/pose on domain " +
+                              domain + ": two robots named 'twin'";
+  first.read_error_until(warning, 20000);
+  second.read_error_until(warning, 20000);
+  EXPECT_NE(first.err().find(warning), std::string::npos) << first.err();
+  EXPECT_NE(second.err().find(warning), std::string::npos) << second.err();
+  second.signal(SIGTERM);
+  ASSERT_TRUE(second.wait(5000).has_value()) << second.err();
+  first.read_error_until("rt/twin/pose has no other writer any more", 20000);
+  EXPECT_NE(first.err().find("rt/twin/pose has no other writer any more"), std::string::npos)
+      << first.err();
+  first.signal(SIGTERM);
+  ASSERT_TRUE(first.wait(5000).has_value()) << first.err();
+  (void)ShmPoseWriter::remove(other_shm);
 }
 
 TEST_F(DaemonLifecycle, DurationEndsTheRunWithExitZero) {
