@@ -102,6 +102,9 @@ class Service {
   int start_pipeline();
   void raise_control_priority();
   void loop();
+  // What other processes did to the outputs since the last status: the
+  // segment written over or truncated, another writer of our DDS topic.
+  void report_interference();
   void reload();
   void shutdown();
   // The configuration the pipeline runs with: the file's, with a replayed
@@ -122,6 +125,10 @@ class Service {
   ProgressCounter progress_;
   std::unique_ptr<capture::CaptureThread> capture_;
   std::optional<ShmPoseWriter> shm_;
+  // Counts already logged by report_interference().
+  uint64_t reported_header_repairs_ = 0;
+  uint64_t reported_truncations_ = 0;
+  size_t reported_other_writers_ = 0;
   std::optional<ShmPoseSink> shm_sink_;
 #ifdef CEILPOSE_DAEMON_HAVE_DDS
   std::optional<DdsPosePublisher> dds_;
@@ -273,9 +280,6 @@ void Service::loop() {
   int64_t next_print = now;
   uint64_t printed_frame = 0;
   PosePrinter printer(start_ns_);
-  uint64_t header_repairs = 0;
-  uint64_t truncations = 0;
-  size_t other_pose_writers = 0;
   bool stalled_reported = false;
 
   for (;;) {
@@ -320,35 +324,7 @@ void Service::loop() {
     }
     if (now >= next_status) {
       next_status = now + status_period_ns;
-#ifdef CEILPOSE_DAEMON_HAVE_DDS
-      if (dds_sink_ && dds_sink_->other_pose_writers() != other_pose_writers) {
-        const size_t before = other_pose_writers;
-        other_pose_writers = dds_sink_->other_pose_writers();
-        if (other_pose_writers > 0) {
-          spdlog::warn(
-              "DDS: {} writer(s) in another process also publish {} on domain {}: two robots "
-              "named '{}', or ceilposed started twice? Subscribers see their poses interleaved; "
-              "give each robot its own --robot / dds.robot_name",
-              other_pose_writers, dds_->pose_topic(), dds_->domain_id(), dds_->robot());
-        } else if (before > 0) {
-          spdlog::info("DDS: {} has no other writer any more", dds_->pose_topic());
-        }
-      }
-#endif
-      if (shm_ && shm_->truncations() != truncations) {
-        truncations = shm_->truncations();
-        spdlog::error(
-            "shared memory: {} (or its -wake companion) was truncated by another process (its "
-            "owner's user or root); grown back to its size, {} times so far; readers re-attach",
-            shm_->name(), truncations);
-      }
-      if (shm_ && shm_->header_repairs() != header_repairs) {
-        header_repairs = shm_->header_repairs();
-        spdlog::error(
-            "shared memory: the header of {} was overwritten by another process (its owner's "
-            "user or root); restored, {} times so far",
-            shm_->name(), header_repairs);
-      }
+      report_interference();
       notifier_.status(status_line(worker_->latest(), worker_->latency()));
     }
     if (now >= next_problems) {
@@ -366,6 +342,38 @@ void Service::loop() {
         printer.print(s);
       }
     }
+  }
+}
+
+void Service::report_interference() {
+#ifdef CEILPOSE_DAEMON_HAVE_DDS
+  if (dds_sink_ && dds_sink_->other_pose_writers() != reported_other_writers_) {
+    const size_t before = reported_other_writers_;
+    reported_other_writers_ = dds_sink_->other_pose_writers();
+    if (reported_other_writers_ > 0) {
+      spdlog::warn(
+          "DDS: {} writer(s) in another process also publish {} on domain {}: two robots "
+          "named '{}', or ceilposed started twice? Subscribers see their poses interleaved; "
+          "give each robot its own --robot / dds.robot_name",
+          reported_other_writers_, dds_->pose_topic(), dds_->domain_id(), dds_->robot());
+    } else if (before > 0) {
+      spdlog::info("DDS: {} has no other writer any more", dds_->pose_topic());
+    }
+  }
+#endif
+  if (shm_ && shm_->truncations() != reported_truncations_) {
+    reported_truncations_ = shm_->truncations();
+    spdlog::error(
+        "shared memory: {} (or its -wake companion) was truncated by another process (its "
+        "owner's user or root); grown back to its size, {} times so far; readers re-attach",
+        shm_->name(), reported_truncations_);
+  }
+  if (shm_ && shm_->header_repairs() != reported_header_repairs_) {
+    reported_header_repairs_ = shm_->header_repairs();
+    spdlog::error(
+        "shared memory: the header of {} was overwritten by another process (its owner's "
+        "user or root); restored, {} times so far",
+        shm_->name(), reported_header_repairs_);
   }
 }
 
