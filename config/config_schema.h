@@ -241,6 +241,10 @@ void describe(V& v, ServiceConfig& c) {
     v.texts("interfaces", o.domain.interfaces, &check_no_space);
     v.texts("peers", o.domain.peers, &check_no_space);
     v.field("status_period_ms", d.status_period_ms, 10, 60'000);
+    v.section("security", [&] {
+      v.text("keystore", d.security.keystore_dir, &check_any_text);
+      v.text("enclave", d.security.enclave, &check_robot_name);
+    });
   });
   v.section("logging", [&] {
     v.choice("level", c.logging.level,

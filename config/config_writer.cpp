@@ -40,11 +40,12 @@ class Writer {
   template <typename Fn>
   void section(const char* name, Fn fn) {
     if (out_ != nullptr) line(name, "");
-    prefix_ = std::string(name) + ".";
+    const std::string outer = prefix_;  // sections nest (dds.security.keystore)
+    prefix_ += std::string(name) + ".";
     indent_ += 2;
     fn();
     indent_ -= 2;
-    prefix_.clear();
+    prefix_ = outer;
   }
   void field(const char* name, int& v, int, int) { line(name, std::to_string(v)); }
   void field(const char* name, uint64_t& v, uint64_t, uint64_t) { line(name, std::to_string(v)); }
@@ -102,9 +103,10 @@ class KeyLister {
  public:
   template <typename Fn>
   void section(const char* name, Fn fn) {
-    prefix_ = std::string(name) + ".";
+    const std::string outer = prefix_;
+    prefix_ += std::string(name) + ".";
     fn();
-    prefix_.clear();
+    prefix_ = outer;
   }
   template <typename... A>
   void field(const char* name, A&&...) {

@@ -34,12 +34,19 @@ struct CaptureConfig {
   uint64_t synthetic_seed = 1;  // noise seed of the synthetic camera
 };
 
+// DDS Security (SPEC §11): on when a keystore is named.
+struct DdsSecurityConfig {
+  std::string keystore_dir;  // "" = plain DDS
+  std::string enclave;       // "" = the robot name
+};
+
 struct DdsConfig {
   bool enabled = true;
   // The publisher's own options (ipc/dds): robot name (empty = the host's,
   // resolved at start), domain id, interfaces, peers, reliability, history.
   DdsOptions publisher;
   int status_period_ms = 1000;  // period of the status topic (the DDS sink's)
+  DdsSecurityConfig security;
 };
 
 enum class LogLevel : uint8_t { kTrace, kDebug, kInfo, kWarn, kError, kCritical, kOff };

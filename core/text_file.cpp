@@ -63,11 +63,17 @@ Result<void> write_file(const std::string& path, const void* data, size_t size) 
   return {};
 }
 
-Result<void> replace_file(const std::string& path, const std::string& text) {
+Result<void> replace_file(const std::string& path, const std::string& text, unsigned mode) {
   const std::string tmp = path + ".tmp";
-  UniqueFd fd(::open(tmp.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644));
+  // O_EXCL and fchmod: a temporary file left by someone else is never
+  // reused with its own, wider, permissions.
+  ::unlink(tmp.c_str());
+  UniqueFd fd(::open(tmp.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, mode));
   if (!fd.valid()) return make_error(tmp + ": cannot create (" + std::strerror(errno) + ")");
-  auto wrote = write_all(fd.get(), tmp, text.data(), text.size());
+  auto wrote =
+      ::fchmod(fd.get(), mode) == 0
+          ? write_all(fd.get(), tmp, text.data(), text.size())
+          : Result<void>(make_error(tmp + ": cannot set mode (" + std::strerror(errno) + ")"));
   if (wrote && ::fsync(fd.get()) != 0)
     wrote = make_error(tmp + ": cannot flush to disk (" + std::strerror(errno) + ")");
   if (wrote && ::close(fd.release()) != 0)

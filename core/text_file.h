@@ -22,6 +22,7 @@ Result<void> write_file(const std::string& path, const void* data, size_t size);
 // Writes `text` to a temporary file beside `path`, flushes it to disk and
 // renames it over `path`: readers see the old file or the whole new one,
 // never a half-written one (a map or calibration that a daemon reloads).
-Result<void> replace_file(const std::string& path, const std::string& text);
+// `mode` is the new file's permission bits (0600 for a private key).
+Result<void> replace_file(const std::string& path, const std::string& text, unsigned mode = 0644);
 
 }  // namespace ceilpose

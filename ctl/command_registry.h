@@ -17,6 +17,10 @@ enum ExitCode : int {
   kExitUsage = 2,     // bad command line
   kExitNoDaemon = 3,  // no daemon publishing, or its pose is stale
   kExitBadInput = 4,  // malformed recording or configuration
+  // A keystore that cannot be made or used: a missing file, a broken
+  // signature, an expired certificate, a key that is not the certificate's.
+  // The same number as ceilposed's.
+  kExitKeystore = 6,
 };
 
 using CommandFactory = void (*)(CLI::App& app);

@@ -2,6 +2,7 @@
 #include <cinttypes>
 #include <cmath>
 #include <cstdio>
+#include <ctime>
 #include <iostream>
 #include <memory>
 #include <string>
@@ -12,6 +13,7 @@
 #include "core/json_text.h"
 #include "ctl/command_registry.h"
 #include "ipc/dds/dds_fleet_listener.h"
+#include "keystore/keystore.h"
 
 namespace ceilpose::ctl {
 namespace {
@@ -22,6 +24,8 @@ struct FleetArgs {
   double duration_s = 2.0;
   std::vector<std::string> interfaces;
   std::vector<std::string> peers;
+  std::string keystore_dir;  // set: listen as enclave `enclave` of this keystore
+  std::string enclave;
 };
 
 std::string json_number(double v) {
@@ -84,6 +88,14 @@ int run_fleet(const FleetArgs& args) {
   options.domain_id = args.domain_id;
   options.interfaces = args.interfaces;
   options.peers = args.peers;
+  if (!args.keystore_dir.empty()) {
+    auto files = keystore::check_enclave(args.keystore_dir, args.enclave, std::time(nullptr));
+    if (!files) {
+      std::cerr << "ceilposectl fleet: keystore: " << files.error().message << "\n";
+      return kExitKeystore;
+    }
+    options.security = std::move(files).value();
+  }
   auto listener = DdsFleetListener::create(options);
   if (!listener) {
     std::cerr << "ceilposectl fleet: " << listener.error().message << "\n";
@@ -111,7 +123,9 @@ void add_fleet_command(CLI::App& app) {
       "List every robot publishing poses on a DDS domain (topics rt/<robot>/pose of type "
       "geometry_msgs/msg/PoseWithCovarianceStamped) with its latest pose and its age.\n"
       "Listens for --duration seconds; exits 0 even when no robot is seen.\n"
-      "Honours CYCLONEDDS_URI; --interface/--peer replace it.");
+      "Honours CYCLONEDDS_URI; --interface/--peer replace it. With --keystore and --enclave\n"
+      "it joins a secure fleet (DDS Security, SPEC §11) and sees only its robots.\n"
+      "Exit 0 ok, 1 DDS failure, 2 usage, 6 keystore refused (names the file).");
   cmd->add_option("--domain", args->domain_id, "DDS domain id")
       ->default_val(0)
       ->check(CLI::Range(0, 230));
@@ -124,6 +138,13 @@ void add_fleet_command(CLI::App& app) {
                   "network interface to use (repeatable), e.g. eth0 or lo");
   cmd->add_option("--peer", args->peers,
                   "unicast discovery peer address (repeatable), e.g. 127.0.0.1");
+  auto* keystore = cmd->add_option("--keystore", args->keystore_dir,
+                                   "keystore directory (ceilposectl keys): listen securely")
+                       ->check(cli::not_empty());
+  cmd->add_option("--enclave", args->enclave, "enclave of the keystore to listen as")
+      ->check(cli::not_empty())
+      ->needs(keystore);
+  keystore->needs(cmd->get_option("--enclave"));
   cmd->callback([args] { set_exit_code(run_fleet(*args)); });
 }
 

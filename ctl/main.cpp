@@ -28,7 +28,7 @@ int main(int argc, char** argv) {
   CLI::App app{
       "ceilposectl — query the ceilpose daemon, record, render and localize offline.\n"
       "Exit codes: 0 ok, 1 runtime error, 2 usage error, 3 no live daemon or stale pose,\n"
-      "4 malformed recording or configuration."};
+      "4 malformed recording or configuration, 6 keystore refused (DDS Security)."};
   app.require_subcommand(1);
   auto& commands = registered_commands();
   std::sort(commands.begin(), commands.end(),

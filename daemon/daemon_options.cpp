@@ -24,10 +24,10 @@ bool parse_command_line(int argc, char** argv, DaemonOptions* options, int* exit
       "Signals: SIGTERM/SIGINT stop cleanly, SIGHUP reloads the configuration file.\n"
       "Exit codes: 0 ok, 1 runtime failure, 2 usage error, 3 bad configuration,\n"
       "4 frame source failure, 5 shared-memory name held (another ceilposed, or another\n"
-      "user's file in /dev/shm)."};
+      "user's file in /dev/shm), 6 keystore refused (DDS Security: names the file)."};
   app.set_version_flag("--version", "ceilposed 0.1.0");
 
-  std::string source, robot, shm, log_level;
+  std::string source, robot, shm, log_level, keystore, enclave;
   int domain = -1;
   bool no_dds = false;
   // Not CLI::ExistingFile: a missing file is a configuration error (exit 3)
@@ -41,6 +41,13 @@ bool parse_command_line(int argc, char** argv, DaemonOptions* options, int* exit
   app.add_option("--shm", shm, "shared-memory segment name (default /ceilpose)")->check(kNotEmpty);
   app.add_option("--domain", domain, "DDS domain id (default 0)");
   app.add_flag("--no-dds", no_dds, "publish on shared memory only");
+  app.add_option(
+         "--keystore", keystore,
+         "DDS Security keystore (ceilposectl keys): authenticate, encrypt and publish only\n"
+         "as this robot's enclave (SPEC §11)")
+      ->check(kNotEmpty);
+  app.add_option("--enclave", enclave, "enclave of the keystore (default: the robot name)")
+      ->check(kNotEmpty);
   app.add_option("--log-level", log_level, "trace | debug | info | warn | error | critical | off")
       ->check(kNotEmpty);
   app.add_option("--duration", options->duration_s,
@@ -67,6 +74,10 @@ bool parse_command_line(int argc, char** argv, DaemonOptions* options, int* exit
   if (!shm.empty()) options->overrides.push_back({"ipc.shm_name", shm, "--shm"});
   if (domain >= 0 || app.count("--domain") > 0)
     options->overrides.push_back({"dds.domain_id", std::to_string(domain), "--domain"});
+  if (!keystore.empty())
+    options->overrides.push_back({"dds.security.keystore", keystore, "--keystore"});
+  if (!enclave.empty())
+    options->overrides.push_back({"dds.security.enclave", enclave, "--enclave"});
   if (no_dds) options->overrides.push_back({"dds.enabled", "false", "--no-dds"});
   if (!log_level.empty()) options->overrides.push_back({"logging.level", log_level, "--log-level"});
   return true;

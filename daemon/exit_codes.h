@@ -13,6 +13,10 @@ enum ExitCode : int {
   // The shared-memory name is held: another live ceilposed, or another
   // user's file, link or directory in /dev/shm. Retrying cannot help.
   kExitShmNameTaken = 5,
+  // DDS Security refused: the keystore misses a file, a signature does not
+  // verify, a certificate has expired or is not the CA's, or the key is not
+  // the certificate's. Nothing was published; retrying cannot help.
+  kExitKeystore = 6,
 };
 
 }  // namespace ceilpose::daemon

@@ -10,6 +10,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
+#include <ctime>
 #include <memory>
 #include <numbers>
 #include <sstream>
@@ -34,6 +35,7 @@
 #include "daemon/dds_pose_sink.h"
 #include "ipc/dds/dds_options.h"
 #include "ipc/dds/dds_pose_publisher.h"
+#include "keystore/keystore.h"
 #endif
 
 namespace ceilpose::daemon {
@@ -96,6 +98,7 @@ class Service {
  private:
   // start() runs the steps in order; each returns kExitOk or the exit code.
   int start();
+  int check_keystore();
   int start_capture();
   int start_shared_memory();
   int start_dds();
@@ -133,6 +136,8 @@ class Service {
 #ifdef CEILPOSE_DAEMON_HAVE_DDS
   std::optional<DdsPosePublisher> dds_;
   std::optional<DdsPoseSink> dds_sink_;
+  // The enclave's files once check_keystore() found them good; unset: plain DDS.
+  std::optional<DdsSecurityFiles> dds_security_;
 #endif
   std::vector<PublishingSink*> sinks_;
   std::unique_ptr<PipelineWorker> worker_;
@@ -142,8 +147,9 @@ class Service {
 
 int Service::start() {
   start_ns_ = monotonic_ns();
-  for (int (Service::*step)() : {&Service::start_capture, &Service::start_shared_memory,
-                                 &Service::start_dds, &Service::start_pipeline}) {
+  for (int (Service::*step)() :
+       {&Service::check_keystore, &Service::start_capture, &Service::start_shared_memory,
+        &Service::start_dds, &Service::start_pipeline}) {
     if (const int rc = (this->*step)(); rc != kExitOk) return rc;
   }
   raise_control_priority();
@@ -198,10 +204,41 @@ int Service::start_shared_memory() {
   return kExitOk;
 }
 
+// First of all steps: a keystore that DDS Security would refuse stops the
+// daemon before a camera is opened or anything is published.
+int Service::check_keystore() {
+  const DdsSecurityConfig& sec = config_.dds.security;
+  if (!config_.dds.enabled || sec.keystore_dir.empty()) return kExitOk;
+#ifdef CEILPOSE_DAEMON_HAVE_DDS
+  const std::string enclave = sec.enclave.empty() ? dds_options(config_).robot : sec.enclave;
+  auto files = keystore::check_enclave(sec.keystore_dir, enclave, std::time(nullptr));
+  if (!files) {
+    spdlog::error("DDS Security: keystore {}: {}", sec.keystore_dir, files.error().message);
+    return kExitKeystore;
+  }
+  dds_security_ = std::move(files).value();
+  spdlog::info("DDS Security: enclave {} of keystore {} (authenticated, encrypted)", enclave,
+               sec.keystore_dir);
+  return kExitOk;
+#else
+  spdlog::error("DDS Security: this ceilposed has no DDS; dds.security.keystore cannot be used");
+  return kExitKeystore;
+#endif
+}
+
 int Service::start_dds() {
 #ifdef CEILPOSE_DAEMON_HAVE_DDS
   if (!config_.dds.enabled) return kExitOk;
-  auto pub = DdsPosePublisher::create(dds_options(config_));
+  DdsOptions options = dds_options(config_);
+  options.domain.security = dds_security_;
+  auto pub = DdsPosePublisher::create(options);
+  if (!pub && dds_security_) {
+    // The files were good (check_keystore), so access control refused what
+    // the permissions do not grant, e.g. an enclave named for another robot.
+    spdlog::error("DDS Security: {} (the permissions of enclave {} must allow publishing rt/{}/*)",
+                  pub.error().message, dds_security_->permissions, options.robot);
+    return kExitKeystore;
+  }
   if (!pub) {
     spdlog::error("DDS: {}", pub.error().message);
     return kExitRuntime;

@@ -104,4 +104,29 @@ std::string cyclone_config_xml(const DdsDomainOptions& options) {
   return xml;
 }
 
+std::vector<std::pair<std::string, std::string>> cyclone_security_properties(
+    const DdsSecurityFiles& files, const std::string& plugin_dir) {
+  const auto file = [](const std::string& path) { return "file:" + path; };
+  const auto plugin = [&](const char* name) { return plugin_dir + "/lib" + name + ".so"; };
+  return {
+      {"dds.sec.auth.library.path", plugin("dds_security_auth")},
+      {"dds.sec.auth.library.init", "init_authentication"},
+      {"dds.sec.auth.library.finalize", "finalize_authentication"},
+      {"dds.sec.crypto.library.path", plugin("dds_security_crypto")},
+      {"dds.sec.crypto.library.init", "init_crypto"},
+      {"dds.sec.crypto.library.finalize", "finalize_crypto"},
+      {"dds.sec.access.library.path", plugin("dds_security_ac")},
+      {"dds.sec.access.library.init", "init_access_control"},
+      {"dds.sec.access.library.finalize", "finalize_access_control"},
+      {"dds.sec.auth.identity_ca", file(files.identity_ca)},
+      {"dds.sec.auth.identity_certificate", file(files.certificate)},
+      {"dds.sec.auth.private_key", file(files.private_key)},
+      {"dds.sec.access.permissions_ca", file(files.permissions_ca)},
+      {"dds.sec.access.governance", file(files.governance)},
+      {"dds.sec.access.permissions", file(files.permissions)},
+  };
+}
+
+const char* cyclone_security_plugin_dir() { return CEILPOSE_DDS_SECURITY_PLUGIN_DIR; }
+
 }  // namespace ceilpose

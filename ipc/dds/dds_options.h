@@ -5,12 +5,27 @@
 #include <optional>
 #include <string>
 #include <string_view>
+#include <utility>
 #include <vector>
 
 #include "core/result.h"
 #include "core/ros_name.h"
 
 namespace ceilpose {
+
+// The six files of an enclave that the DDS Security plugins read (OMG DDS
+// Security 1.1, builtin PKI-DH, Access-Permissions and AES-GCM-GMAC). They
+// are given to the participant as QoS properties, so they compose with
+// whatever CYCLONEDDS_URI or the explicit domain says about the network.
+// keystore/ finds and checks them; here they are only paths.
+struct DdsSecurityFiles {
+  std::string identity_ca;     // PEM certificate of the identity CA
+  std::string certificate;     // PEM certificate of this participant (CN=<enclave>)
+  std::string private_key;     // PEM private key matching `certificate`
+  std::string permissions_ca;  // PEM certificate that signed governance and permissions
+  std::string governance;      // S/MIME signed governance document (.p7s)
+  std::string permissions;     // S/MIME signed permissions document (.p7s)
+};
 
 // Where the participant lives. With no interfaces, peers or multicast choice
 // Cyclone reads its configuration from CYCLONEDDS_URI as usual; otherwise
@@ -22,6 +37,9 @@ struct DdsDomainOptions {
   std::vector<std::string> peers;       // unicast discovery peers, e.g. "10.0.0.7", "127.0.0.1"
   // Unset keeps Cyclone's default.
   std::optional<bool> allow_multicast;
+  // Set: the participant authenticates, is access-controlled and encrypts
+  // (DDS Security); unset: plain DDS, as before.
+  std::optional<DdsSecurityFiles> security;
 
   bool needs_explicit_domain() const {
     return !interfaces.empty() || !peers.empty() || allow_multicast.has_value();
@@ -57,5 +75,14 @@ Result<void> validate(const DdsOptions& options);
 // The Cyclone XML fragment for the explicit settings of `options`
 // (<CycloneDDS><Domain id="any">...), valid for dds_create_domain.
 std::string cyclone_config_xml(const DdsDomainOptions& options);
+
+// The participant QoS properties (name, value) that turn on Cyclone's DDS
+// Security plugins with `files`; the plugins are loaded from
+// `plugin_dir` (Debian installs them outside the linker's path).
+std::vector<std::pair<std::string, std::string>> cyclone_security_properties(
+    const DdsSecurityFiles& files, const std::string& plugin_dir);
+
+// Where this build found Cyclone's security plugins (CMake, at configure time).
+const char* cyclone_security_plugin_dir();
 
 }  // namespace ceilpose

@@ -29,12 +29,24 @@ Result<DdsParticipant> DdsParticipant::create(const DdsDomainOptions& options) {
       return dds_error("cannot create " + domain_name + " with configuration " + config, rc);
     }
   }
-  p.participant_ = dds_create_participant(options.domain_id, nullptr, nullptr);
+  dds_qos_t* qos = nullptr;
+  if (options.security) {
+    qos = dds_create_qos();
+    for (const auto& [name, value] :
+         cyclone_security_properties(*options.security, cyclone_security_plugin_dir())) {
+      dds_qset_prop(qos, name.c_str(), value.c_str());
+    }
+  }
+  p.participant_ = dds_create_participant(options.domain_id, qos, nullptr);
+  if (qos != nullptr) dds_delete_qos(qos);
   if (p.participant_ < 0) {
     const dds_return_t rc = p.participant_;
     p.participant_ = 0;
-    return dds_error("cannot create a participant on " + domain_name +
-                         " (check CYCLONEDDS_URI and the network interfaces)",
+    return dds_error(options.security ? "the DDS Security plugins refused the enclave of " +
+                                            options.security->certificate + " on " + domain_name +
+                                            " (run with CYCLONEDDS_URI tracing 'security' for why)"
+                                      : "cannot create a participant on " + domain_name +
+                                            " (check CYCLONEDDS_URI and the network interfaces)",
                      rc);
   }
   return p;

@@ -166,8 +166,10 @@ struct FieldAddresses {
 
   template <typename Fn>
   void section(const char* name, Fn&& fn) {
-    section_name = name;
+    const std::string outer = section_name;
+    section_name = outer.empty() ? std::string(name) : outer + "." + name;
     fn();
+    section_name = outer;
   }
   template <typename T, typename... Rest>
   void add(const char* name, T& value) {
@@ -225,6 +227,8 @@ TEST(ConfigSchema, EveryKeyIsBoundToTheOptionsOfTheModuleThatUsesIt) {
       "watchdog.status_interval_ms",         // STATUS= and ShmPoseSink's status period
       "dds.enabled",                         // whether Service::start_dds runs
       "dds.status_period_ms",                // DdsPoseSink's status period
+      "dds.security.keystore",               // Service::check_keystore (keystore/)
+      "dds.security.enclave",                // Service::check_keystore (keystore/)
       "camera.calibration_file",             // load_calibration_files (calibration/)
       "ceiling.map",                         // load_calibration_files (calibration/)
   };

@@ -10,6 +10,7 @@
 
 #include "core/clock.h"
 #include "ipc/dds/dds_pose_publisher.h"
+#include "keystore/keystore.h"
 
 namespace {
 
@@ -26,6 +27,7 @@ int main(int argc, char** argv) {
   std::vector<double> velocity;
   int64_t stamp_ns = -1;
   bool best_effort = false;
+  std::string keystore_dir, enclave;
   app.add_option("--robot", options.robot, "robot name (ROS name)")->required();
   app.add_option("--domain", options.domain.domain_id, "DDS domain id")->default_val(0);
   app.add_option("--x", x_m, "x, metres");
@@ -42,7 +44,18 @@ int main(int argc, char** argv) {
   app.add_flag("--best-effort", best_effort, "best-effort writer instead of reliable");
   app.add_option("--interface", options.domain.interfaces, "network interface (repeatable)");
   app.add_option("--peer", options.domain.peers, "unicast discovery peer (repeatable)");
+  app.add_option("--keystore", keystore_dir, "DDS Security keystore (ceilposectl keys)");
+  app.add_option("--enclave", enclave, "enclave of --keystore (default: --robot)");
   CLI11_PARSE(app, argc, argv);
+  if (!keystore_dir.empty()) {
+    auto files = keystore::check_enclave(keystore_dir, enclave.empty() ? options.robot : enclave,
+                                         std::time(nullptr));
+    if (!files) {
+      std::cerr << "ceilpose_dds_fake_robot: " << files.error().message << "\n";
+      return 6;
+    }
+    options.domain.security = std::move(files).value();
+  }
   if (best_effort) options.reliability = DdsReliability::kBestEffort;
 
   std::signal(SIGTERM, on_signal);

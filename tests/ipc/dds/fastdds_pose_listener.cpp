@@ -27,6 +27,7 @@
 #include <memory>
 #include <string>
 #include <thread>
+#include <utility>
 
 namespace {
 
@@ -127,6 +128,7 @@ int main(int argc, char** argv) {
   int count = 3;
   long timeout_ms = 20000;
   bool odom = false;
+  std::string enclave_dir;  // set: DDS Security with this SROS2 enclave's files
   for (int k = 1; k + 1 < argc; k += 2) {
     if (std::strcmp(argv[k], "--domain") == 0)
       domain_id = std::atoi(argv[k + 1]);
@@ -138,11 +140,13 @@ int main(int argc, char** argv) {
       timeout_ms = std::atol(argv[k + 1]);
     else if (std::strcmp(argv[k], "--type") == 0)
       odom = std::strcmp(argv[k + 1], "odom") == 0;
+    else if (std::strcmp(argv[k], "--enclave-dir") == 0)
+      enclave_dir = argv[k + 1];
   }
   if (topic_name.empty()) {
     std::fprintf(stderr,
                  "usage: %s --topic rt/<robot>/pose [--type pose|odom] [--domain ID] [--count N] "
-                 "[--timeout-ms T]\n",
+                 "[--timeout-ms T] [--enclave-dir DIR]\n",
                  argv[0]);
     return 2;
   }
@@ -159,6 +163,24 @@ int main(int argc, char** argv) {
   frtps::Locator_t peer;
   frtps::IPLocator::setIPv4(peer, 127, 0, 0, 1);
   pqos.wire_protocol().builtin.initialPeersList.push_back(peer);
+  if (!enclave_dir.empty()) {
+    // Fast DDS's builtin plugins by their DDS Security names, as an SROS2
+    // user's rmw_fastrtps sets them from ROS_SECURITY_ENCLAVE.
+    const std::string f = "file://" + enclave_dir + "/";  // Fast DDS wants a file:// URI
+    for (const auto& [name, value] : std::initializer_list<std::pair<const char*, std::string>>{
+             {"dds.sec.auth.plugin", "builtin.PKI-DH"},
+             {"dds.sec.auth.builtin.PKI-DH.identity_ca", f + "identity_ca.cert.pem"},
+             {"dds.sec.auth.builtin.PKI-DH.identity_certificate", f + "cert.pem"},
+             {"dds.sec.auth.builtin.PKI-DH.private_key", f + "key.pem"},
+             {"dds.sec.access.plugin", "builtin.Access-Permissions"},
+             {"dds.sec.access.builtin.Access-Permissions.permissions_ca",
+              f + "permissions_ca.cert.pem"},
+             {"dds.sec.access.builtin.Access-Permissions.governance", f + "governance.p7s"},
+             {"dds.sec.access.builtin.Access-Permissions.permissions", f + "permissions.p7s"},
+             {"dds.sec.crypto.plugin", "builtin.AES-GCM-GMAC"}}) {
+      pqos.properties().properties().emplace_back(name, value);
+    }
+  }
 
   auto* factory = fdds::DomainParticipantFactory::get_instance();
   fdds::DomainParticipant* participant = factory->create_participant(domain_id, pqos);
