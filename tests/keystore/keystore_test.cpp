@@ -11,7 +11,7 @@
 
 #include "core/text_file.h"
 #include "keystore/keystore_layout.h"
-#include "tests/recording/recording_test_support.h"
+#include "tests/keystore/test_keystore.h"
 #include "tests/support/child_process.h"
 
 namespace ceilpose::keystore {
@@ -36,19 +36,15 @@ unsigned mode_of(const std::string& path) {
 
 class KeystoreTest : public ::testing::Test {
  protected:
-  void SetUp() override {
-    ASSERT_TRUE(init_keystore(dir(), {now_ - 30 * kDay, kDefaultCaDays}));
-    ASSERT_TRUE(add_enclave(dir(), {.name = "r1", .validity = {now_, 30}}));
-  }
-  std::string dir() const { return tmp_.sub("keystore"); }
-  KeystoreLayout layout() const { return KeystoreLayout{dir()}; }
-  DdsSecurityFiles r1() const { return layout().enclave_files("r1"); }
+  std::string dir() const { return ks_.dir(); }
+  KeystoreLayout layout() const { return ks_.layout(); }
+  DdsSecurityFiles r1() const { return ks_.files("r1"); }
   std::string check_error(const std::string& enclave, std::time_t at) const {
     auto checked = check_enclave(dir(), enclave, at);
     return checked ? std::string("(no error)") : checked.error().message;
   }
 
-  test::TempDir tmp_;
+  test::TestKeystore ks_{"r1"};
   std::time_t now_ = std::time(nullptr);
 };
 
@@ -134,7 +130,7 @@ TEST_F(KeystoreTest, AddRefusesANameThatIsNotARosNameAndAKeystoreWithoutCa) {
   for (const char* bad : {"", "1robot", "a/b", "a__b"}) {
     EXPECT_FALSE(add_enclave(dir(), {.name = bad, .validity = {now_, 10}})) << bad;
   }
-  auto no_ca = add_enclave(tmp_.sub("empty"), {.name = "r1", .validity = {now_, 10}});
+  auto no_ca = add_enclave(ks_.sibling("empty"), {.name = "r1", .validity = {now_, 10}});
   ASSERT_FALSE(no_ca);
   EXPECT_NE(no_ca.error().message.find("has no CA"), std::string::npos);
   EXPECT_NE(no_ca.error().message.find("keys init --keystore"), std::string::npos);
@@ -193,7 +189,7 @@ TEST_F(KeystoreTest, AnExpiredOrNotYetValidCertificateIsRefusedWithItsDate) {
 }
 
 TEST_F(KeystoreTest, AnEnclaveOfAnotherKeystoreIsNotIssuedByItsCa) {
-  const std::string other = tmp_.sub("other");
+  const std::string other = ks_.sibling("other");
   ASSERT_TRUE(init_keystore(other, {now_, 100}));
   // The robot keeps its certificate but is handed another fleet's CA.
   std::filesystem::copy_file(KeystoreLayout{other}.ca_certificate(), r1().identity_ca,

@@ -17,25 +17,14 @@ namespace ceilpose {
 namespace {
 
 using test::ChildProcess;
+using test::number_field;
+using test::robot_object;
 
 constexpr char kPoseType[] = "geometry_msgs::msg::dds_::PoseWithCovarianceStamped_";
 // Generous bounds: discovery takes milliseconds on an idle machine but the
 // suite also runs under ASan on two loaded cores.
 constexpr int64_t kReadyTimeoutMs = 20'000;
 constexpr int64_t kFleetTimeoutMs = 30'000;
-
-// The JSON object of `robot` in ceilposectl fleet --json output, or "".
-std::string robot_object(const std::string& json, const std::string& robot) {
-  const size_t at = json.find("{\"robot\":\"" + robot + "\"");
-  if (at == std::string::npos) return {};
-  return json.substr(at, json.find('}', at) - at + 1);
-}
-
-double number_field(const std::string& object, const std::string& key) {
-  const size_t at = object.find("\"" + key + "\":");
-  if (at == std::string::npos) return std::nan("");
-  return std::strtod(object.c_str() + at + key.size() + 3, nullptr);
-}
 
 class DdsCrossProcess : public ::testing::Test {
  protected:

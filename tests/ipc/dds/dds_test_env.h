@@ -3,6 +3,7 @@
 // parallel test processes and other machines never see each other.
 #include <unistd.h>
 
+#include <cmath>
 #include <cstdint>
 #include <cstdlib>
 #include <string>
@@ -27,6 +28,20 @@ inline uint32_t unique_domain_id() { return 1 + static_cast<uint32_t>(getpid()) 
 
 inline std::string unique_robot_name(const char* prefix) {
   return std::string(prefix) + std::to_string(getpid());
+}
+
+// The JSON object of `robot` in `ceilposectl fleet --json` output, or "".
+inline std::string robot_object(const std::string& json, const std::string& robot) {
+  const size_t at = json.find("{\"robot\":\"" + robot + "\"");
+  if (at == std::string::npos) return {};
+  return json.substr(at, json.find('}', at) - at + 1);
+}
+
+// A number field of such an object, NaN when absent.
+inline double number_field(const std::string& object, const std::string& key) {
+  const size_t at = object.find("\"" + key + "\":");
+  if (at == std::string::npos) return std::nan("");
+  return std::strtod(object.c_str() + at + key.size() + 3, nullptr);
 }
 
 }  // namespace ceilpose::test
