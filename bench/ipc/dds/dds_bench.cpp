@@ -10,6 +10,13 @@
 //  - BM_DdsPoseRoundTripWaitset: the same, but an application thread blocks
 //    in a waitset for each echo (one iteration = one round trip), as a
 //    consumer thread would: adds a thread wake-up per echo.
+//  - BM_DdsPoseRoundTrip/secure:1 and the others with secure:1: the same
+//    with DDS Security (issue 14): both processes authenticated with an
+//    enclave of a keystore made here, topic data encrypted and signed.
+//  - BM_DdsPose60Hz/secure:0|1: a robot's real load, one pose every 16.7 ms
+//    for 10 s, each echoed back: round-trip percentiles, and this process's
+//    CPU time (all its threads, Cyclone's included) per pose and as a share
+//    of one core. Run together, the pair gives what security costs.
 //  - BM_DdsperfRoundTrip: `ddsperf -D 5 ping` against `ddsperf pong` on the
 //    same configuration, percentiles parsed from its output, and the ratios
 //    of BM_DdsPoseRoundTrip's figures to it (target <= 1.5).
@@ -21,6 +28,7 @@
 // must come to about one second.
 #include <benchmark/benchmark.h>
 #include <dds/dds.h>
+#include <sys/resource.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -29,6 +37,8 @@
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
+#include <ctime>
+#include <filesystem>
 #include <mutex>
 #include <regex>
 #include <sstream>
@@ -37,6 +47,7 @@
 
 #include "core/clock.h"
 #include "ipc/dds/dds_pose_publisher.h"
+#include "keystore/keystore.h"
 #include "tests/ipc/dds/dds_test_env.h"
 #include "tests/support/child_process.h"
 
@@ -87,11 +98,40 @@ WindowPercentiles per_second_percentiles(const std::vector<int64_t>& sent_at_ns,
   return out;
 }
 
-DdsOptions bench_options(const char* robot, uint32_t domain_id) {
+// The keystore of the secure runs, made once per run in a temporary
+// directory (removed by main), with an enclave for each side.
+const std::string& bench_keystore() {
+  static const std::string dir = [] {
+    char tmpl[] = "/tmp/ceilpose-dds-bench-XXXXXX";
+    const std::string root = mkdtemp(tmpl) != nullptr ? tmpl : "";
+    const std::string ks = root + "/keystore";
+    const std::time_t now = std::time(nullptr);
+    bool ok = !root.empty() && keystore::init_keystore(ks, {now, 1}).ok();
+    for (const char* robot : {kPingRobot, kPongRobot})
+      ok = ok && keystore::add_enclave(ks, {.name = robot, .validity = {now, 1}}).ok();
+    return ok ? ks : std::string();
+  }();
+  return dir;
+}
+
+// `keystore` empty: plain DDS; else DDS Security as enclave `robot` of it.
+Result<DdsOptions> bench_options(const char* robot, uint32_t domain_id,
+                                 const std::string& keystore) {
   DdsOptions o;
   o.robot = robot;
   o.domain.domain_id = domain_id;
+  if (keystore.empty()) return o;
+  auto files = keystore::check_enclave(keystore, robot, std::time(nullptr));
+  if (!files) return files.error();
+  o.domain.security = std::move(files).value();
   return o;
+}
+
+Result<DdsPosePublisher> bench_publisher(const char* robot, uint32_t domain_id,
+                                         const std::string& keystore) {
+  auto options = bench_options(robot, domain_id, keystore);
+  if (!options) return options.error();
+  return DdsPosePublisher::create(*options);
 }
 
 // A reliable reader of rt/<robot>/pose, with a data-available listener when
@@ -159,8 +199,8 @@ void pong_on_data(dds_entity_t reader, void* arg) {
   while (PoseReader::take_now(reader, &pong->msg, &pose)) (void)pong->pub->publish(pose);
 }
 
-int run_pong(uint32_t domain_id) {
-  auto pub = DdsPosePublisher::create(bench_options(kPongRobot, domain_id));
+int run_pong(uint32_t domain_id, const std::string& keystore) {
+  auto pub = bench_publisher(kPongRobot, domain_id, keystore);
   if (!pub) {
     std::fprintf(stderr, "dds_bench --pong: %s\n", pub.error().message.c_str());
     return 1;
@@ -183,23 +223,31 @@ int run_pong(uint32_t domain_id) {
 // publisher's participant, one participant per process as in ddsperf.
 class PingSide {
  public:
-  explicit PingSide(uint32_t domain_id)
-      : pong_({"/proc/self/exe", "--pong", std::to_string(domain_id)}),
-        pub_(DdsPosePublisher::create(bench_options(kPingRobot, domain_id))) {}
+  // secure: both sides authenticate and encrypt with bench_keystore().
+  PingSide(uint32_t domain_id, bool secure)
+      : keystore_(secure ? bench_keystore() : std::string()),
+        pong_({"/proc/self/exe", "--pong", std::to_string(domain_id), keystore_}),
+        pub_(bench_publisher(kPingRobot, domain_id, keystore_)) {}
 
   // Null when ready, else what went wrong.
   const char* setup_error() {
     if (pong_.read_until("ready", kMatchTimeoutMs).find("ready") == std::string::npos) {
       return "pong process did not start";
     }
-    return pub_.ok() ? nullptr : "cannot create the DDS publisher";
+    if (!pub_.ok()) {
+      error_ = "cannot create the DDS publisher: " + pub_.error().message;
+      return error_.c_str();
+    }
+    return nullptr;
   }
   DdsPosePublisher& pub() { return *pub_; }
   dds_entity_t participant() const { return pub_->participant_handle(); }
 
  private:
+  std::string keystore_;  // before pong_ and pub_, which use it
   test::ChildProcess pong_;
   Result<DdsPosePublisher> pub_;
+  std::string error_;
 };
 
 // Round trips driven from the listener: each echo sends the next ping.
@@ -248,7 +296,7 @@ void ping_on_data(dds_entity_t reader, void* arg) {
 }
 
 void BM_DdsPoseRoundTrip(benchmark::State& state) {
-  PingSide side(test::unique_domain_id());
+  PingSide side(test::unique_domain_id(), state.range(0) != 0);
   if (const char* error = side.setup_error()) return state.SkipWithError(error);
   PingChain chain;
   chain.pub = &side.pub();
@@ -275,50 +323,126 @@ void BM_DdsPoseRoundTrip(benchmark::State& state) {
   }
   std::lock_guard lock(chain.m);
   const auto windows = per_second_percentiles(chain.sent_at_ns, chain.rtt_us);
-  g_ours_p50_us = percentile(windows.p50_us, 0.5);
-  g_ours_p99_us = percentile(windows.p99_us, 0.5);
+  if (state.range(0) == 0) {  // ddsperf runs without security
+    g_ours_p50_us = percentile(windows.p50_us, 0.5);
+    g_ours_p99_us = percentile(windows.p99_us, 0.5);
+  }
   state.counters["rtt_p50_us"] = percentile(chain.rtt_us, 0.50);
   state.counters["rtt_p99_us"] = percentile(chain.rtt_us, 0.99);
-  state.counters["rtt_p50_us_1s_median"] = g_ours_p50_us;
-  state.counters["rtt_p99_us_1s_median"] = g_ours_p99_us;
+  state.counters["rtt_p50_us_1s_median"] = percentile(windows.p50_us, 0.5);
+  state.counters["rtt_p99_us_1s_median"] = percentile(windows.p99_us, 0.5);
   state.counters["round_trips"] = static_cast<double>(chain.rtt_us.size());
   state.counters["payload_bytes"] = 364;
 }
-BENCHMARK(BM_DdsPoseRoundTrip)->MinTime(5.0)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK(BM_DdsPoseRoundTrip)
+    ->ArgName("secure")
+    ->Arg(0)
+    ->Arg(1)
+    ->MinTime(5.0)
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
+
+// Pings until the pong's echo comes back (a reliable writer drops what it
+// writes before it has matched), then drains the discovery echoes.
+bool match_pong(DdsPosePublisher* pub, PoseReader* reader, DdsPose* ping) {
+  DdsPose echo;
+  const int64_t match_deadline_ns = monotonic_ns() + kMatchTimeoutMs * 1'000'000;
+  bool matched = false;
+  while (!matched && monotonic_ns() < match_deadline_ns) {
+    (void)pub->publish(*ping);
+    matched = reader->take(50, &echo);
+  }
+  while (matched && reader->take(100, &echo)) {
+  }
+  return matched;
+}
+
+// One ping, waited for in `reader`: the round trip in us, or < 0 when lost.
+double round_trip_us(DdsPosePublisher* pub, PoseReader* reader, DdsPose* ping) {
+  ping->pose.x_m += 1.0;
+  const int64_t t0 = monotonic_ns();
+  DdsPose echo;
+  if (!pub->publish(*ping) || !reader->take(kEchoTimeoutMs, &echo) ||
+      echo.pose.x_m != ping->pose.x_m) {
+    return -1.0;
+  }
+  return static_cast<double>(monotonic_ns() - t0) / 1e3;
+}
 
 void BM_DdsPoseRoundTripWaitset(benchmark::State& state) {
-  PingSide side(test::unique_domain_id());
+  PingSide side(test::unique_domain_id(), state.range(0) != 0);
   if (const char* error = side.setup_error()) return state.SkipWithError(error);
   DdsPosePublisher* pub = &side.pub();
   PoseReader reader(side.participant(), kPongRobot, nullptr, nullptr);
   DdsPose ping;
   ping.valid = true;
-  DdsPose echo;
-  const int64_t match_deadline_ns = monotonic_ns() + kMatchTimeoutMs * 1'000'000;
-  bool matched = false;
-  while (!matched && monotonic_ns() < match_deadline_ns) {
-    (void)pub->publish(ping);
-    matched = reader.take(50, &echo);
-  }
-  if (!matched) return state.SkipWithError("no echo from the pong process");
-  while (reader.take(100, &echo)) {
-  }  // drain the echoes of the discovery pings
+  if (!match_pong(pub, &reader, &ping)) return state.SkipWithError("no echo from the pong process");
 
   std::vector<double> rtt_us;
   rtt_us.reserve(1 << 22);
   for (auto _ : state) {
-    ping.pose.x_m += 1.0;
-    const int64_t t0 = monotonic_ns();
-    if (auto ok = pub->publish(ping); !ok) return state.SkipWithError(ok.error().message.c_str());
-    if (!reader.take(kEchoTimeoutMs, &echo) || echo.pose.x_m != ping.pose.x_m) {
-      return state.SkipWithError("echo lost or out of order");
-    }
-    rtt_us.push_back(static_cast<double>(monotonic_ns() - t0) / 1e3);
+    const double us = round_trip_us(pub, &reader, &ping);
+    if (us < 0.0) return state.SkipWithError("echo lost or out of order");
+    rtt_us.push_back(us);
   }
   state.counters["rtt_p50_us"] = percentile(rtt_us, 0.50);
   state.counters["rtt_p99_us"] = percentile(rtt_us, 0.99);
 }
-BENCHMARK(BM_DdsPoseRoundTripWaitset)->MinTime(3.0)->Unit(benchmark::kMicrosecond)->UseRealTime();
+BENCHMARK(BM_DdsPoseRoundTripWaitset)
+    ->ArgName("secure")
+    ->Arg(0)
+    ->Arg(1)
+    ->MinTime(3.0)
+    ->Unit(benchmark::kMicrosecond)
+    ->UseRealTime();
+
+double process_cpu_s() {
+  rusage u{};
+  getrusage(RUSAGE_SELF, &u);
+  return static_cast<double>(u.ru_utime.tv_sec + u.ru_stime.tv_sec) +
+         static_cast<double>(u.ru_utime.tv_usec + u.ru_stime.tv_usec) / 1e6;
+}
+
+// A robot's load: 60 poses a second, each echoed, for 10 s per iteration.
+void BM_DdsPose60Hz(benchmark::State& state) {
+  constexpr int kRateHz = 60;
+  constexpr int kPoses = 10 * kRateHz;
+  PingSide side(test::unique_domain_id(), state.range(0) != 0);
+  if (const char* error = side.setup_error()) return state.SkipWithError(error);
+  DdsPosePublisher* pub = &side.pub();
+  PoseReader reader(side.participant(), kPongRobot, nullptr, nullptr);
+  DdsPose ping;
+  ping.valid = true;
+  if (!match_pong(pub, &reader, &ping)) return state.SkipWithError("no echo from the pong process");
+  std::vector<double> rtt_us;
+  double cpu_s = 0.0, wall_s = 0.0;
+  for (auto _ : state) {
+    const double cpu0 = process_cpu_s();
+    const int64_t start_ns = monotonic_ns();
+    for (int i = 0; i < kPoses; ++i) {
+      const int64_t due_ns = start_ns + i * 1'000'000'000LL / kRateHz;
+      const timespec until{static_cast<time_t>(due_ns / 1'000'000'000),
+                           static_cast<long>(due_ns % 1'000'000'000)};
+      clock_nanosleep(CLOCK_MONOTONIC, TIMER_ABSTIME, &until, nullptr);
+      const double us = round_trip_us(pub, &reader, &ping);
+      if (us < 0.0) return state.SkipWithError("echo lost or out of order");
+      rtt_us.push_back(us);
+    }
+    cpu_s += process_cpu_s() - cpu0;
+    wall_s += static_cast<double>(monotonic_ns() - start_ns) / 1e9;
+  }
+  state.counters["rtt_p50_us"] = percentile(rtt_us, 0.50);
+  state.counters["rtt_p99_us"] = percentile(rtt_us, 0.99);
+  state.counters["cpu_us_per_pose"] = cpu_s * 1e6 / static_cast<double>(rtt_us.size());
+  state.counters["cpu_percent_of_core"] = 100.0 * cpu_s / wall_s;
+}
+BENCHMARK(BM_DdsPose60Hz)
+    ->ArgName("secure")
+    ->Arg(0)
+    ->Arg(1)
+    ->Iterations(1)
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
 
 // ddsperf prints one line per second per peer:
 //   [pid] 3.000  host:pid size 364 mean 28.9us min 10.8us 50% 28.2us ... cnt 17294
@@ -388,11 +512,15 @@ BENCHMARK(BM_DdsperfRoundTrip)->Iterations(1)->Unit(benchmark::kMillisecond)->Us
 int main(int argc, char** argv) {
   // Loopback only, on a domain of this run, for us and for ddsperf alike.
   ceilpose::test::use_loopback_dds();
-  if (argc > 2 && std::strcmp(argv[1], "--pong") == 0) {
-    return ceilpose::run_pong(static_cast<uint32_t>(std::strtoul(argv[2], nullptr, 10)));
+  if (argc > 3 && std::strcmp(argv[1], "--pong") == 0) {
+    return ceilpose::run_pong(static_cast<uint32_t>(std::strtoul(argv[2], nullptr, 10)), argv[3]);
   }
   benchmark::Initialize(&argc, argv);
   benchmark::RunSpecifiedBenchmarks();
   benchmark::Shutdown();
+  // The keystore, if a secure benchmark made one.
+  if (const std::string& ks = ceilpose::bench_keystore(); !ks.empty()) {
+    std::filesystem::remove_all(std::filesystem::path(ks).parent_path());
+  }
   return 0;
 }
