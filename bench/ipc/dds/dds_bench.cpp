@@ -98,15 +98,20 @@ WindowPercentiles per_second_percentiles(const std::vector<int64_t>& sent_at_ns,
   return out;
 }
 
-// The keystore of the secure runs, made once per run in a temporary
-// directory (removed by main), with an enclave for each side.
+// The temporary directory of the secure runs' keystore, once one is made;
+// main removes it.
+std::string g_keystore_root;
+
+// The keystore of the secure runs, made once per run with an enclave for
+// each side; empty if it could not be made.
 const std::string& bench_keystore() {
   static const std::string dir = [] {
     char tmpl[] = "/tmp/ceilpose-dds-bench-XXXXXX";
-    const std::string root = mkdtemp(tmpl) != nullptr ? tmpl : "";
-    const std::string ks = root + "/keystore";
+    if (mkdtemp(tmpl) == nullptr) return std::string();
+    g_keystore_root = tmpl;
+    const std::string ks = g_keystore_root + "/keystore";
     const std::time_t now = std::time(nullptr);
-    bool ok = !root.empty() && keystore::init_keystore(ks, {now, 1}).ok();
+    bool ok = keystore::init_keystore(ks, {now, 1}).ok();
     for (const char* robot : {kPingRobot, kPongRobot})
       ok = ok && keystore::add_enclave(ks, {.name = robot, .validity = {now, 1}}).ok();
     return ok ? ks : std::string();
@@ -225,12 +230,14 @@ class PingSide {
  public:
   // secure: both sides authenticate and encrypt with bench_keystore().
   PingSide(uint32_t domain_id, bool secure)
-      : keystore_(secure ? bench_keystore() : std::string()),
+      : secure_(secure),
+        keystore_(secure ? bench_keystore() : std::string()),
         pong_({"/proc/self/exe", "--pong", std::to_string(domain_id), keystore_}),
         pub_(bench_publisher(kPingRobot, domain_id, keystore_)) {}
 
   // Null when ready, else what went wrong.
   const char* setup_error() {
+    if (secure_ && keystore_.empty()) return "cannot make the benchmark's keystore";
     if (pong_.read_until("ready", kMatchTimeoutMs).find("ready") == std::string::npos) {
       return "pong process did not start";
     }
@@ -244,6 +251,7 @@ class PingSide {
   dds_entity_t participant() const { return pub_->participant_handle(); }
 
  private:
+  bool secure_;
   std::string keystore_;  // before pong_ and pub_, which use it
   test::ChildProcess pong_;
   Result<DdsPosePublisher> pub_;
@@ -518,9 +526,6 @@ int main(int argc, char** argv) {
   benchmark::Initialize(&argc, argv);
   benchmark::RunSpecifiedBenchmarks();
   benchmark::Shutdown();
-  // The keystore, if a secure benchmark made one.
-  if (const std::string& ks = ceilpose::bench_keystore(); !ks.empty()) {
-    std::filesystem::remove_all(std::filesystem::path(ks).parent_path());
-  }
+  if (!ceilpose::g_keystore_root.empty()) std::filesystem::remove_all(ceilpose::g_keystore_root);
   return 0;
 }
