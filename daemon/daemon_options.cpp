@@ -57,7 +57,8 @@ bool parse_command_line(int argc, char** argv, DaemonOptions* options, int* exit
                "print a line per pose (at most 10 per second): time, x, y, yaw, mode, markers,\n"
                "ground truth and error when the source knows it, latency");
   app.add_option("--check-config", options->check_config_path,
-                 "validate FILE and exit: 0 when valid, 3 with the problem on stderr")
+                 "validate FILE (and the keystore it names) and exit: 0 when valid, 3 with the\n"
+                 "problem on stderr, 6 when DDS Security would refuse its keystore")
       ->check(kNotEmpty);
   app.add_flag("--print-config", options->print_config,
                "print the effective configuration (file + options) as YAML and exit");

@@ -43,6 +43,10 @@ int main(int argc, char** argv) {
       std::fprintf(stderr, "ceilposed: %s\n", checked.error().message.c_str());
       return kExitBadConfig;
     }
+    if (const std::string problem = keystore_problem(*checked); !problem.empty()) {
+      std::fprintf(stderr, "ceilposed: DDS Security: %s\n", problem.c_str());
+      return kExitKeystore;
+    }
     std::printf("%s: valid\n", options.check_config_path.c_str());
     return flushed(kExitOk);
   }

@@ -86,6 +86,20 @@ DdsOptions dds_options(const ServiceConfig& c) {
   }
   return o;
 }
+
+// dds.security.enclave, or the robot name.
+std::string enclave_name(const ServiceConfig& c) {
+  return c.dds.security.enclave.empty() ? dds_options(c).robot : c.dds.security.enclave;
+}
+
+// The configured enclave's files as check_enclave finds them now.
+Result<DdsSecurityFiles> checked_enclave(const ServiceConfig& c) {
+  auto files =
+      keystore::check_enclave(c.dds.security.keystore_dir, enclave_name(c), std::time(nullptr));
+  if (!files)
+    return make_error("keystore " + c.dds.security.keystore_dir + ": " + files.error().message);
+  return files;
+}
 #endif
 
 class Service {
@@ -210,18 +224,17 @@ int Service::check_keystore() {
   const DdsSecurityConfig& sec = config_.dds.security;
   if (!config_.dds.enabled || sec.keystore_dir.empty()) return kExitOk;
 #ifdef CEILPOSE_DAEMON_HAVE_DDS
-  const std::string enclave = sec.enclave.empty() ? dds_options(config_).robot : sec.enclave;
-  auto files = keystore::check_enclave(sec.keystore_dir, enclave, std::time(nullptr));
+  auto files = checked_enclave(config_);
   if (!files) {
-    spdlog::error("DDS Security: keystore {}: {}", sec.keystore_dir, files.error().message);
+    spdlog::error("DDS Security: {}", files.error().message);
     return kExitKeystore;
   }
   dds_security_ = std::move(files).value();
-  spdlog::info("DDS Security: enclave {} of keystore {} (authenticated, encrypted)", enclave,
-               sec.keystore_dir);
+  spdlog::info("DDS Security: enclave {} of keystore {} (authenticated, encrypted)",
+               enclave_name(config_), sec.keystore_dir);
   return kExitOk;
 #else
-  spdlog::error("DDS Security: this ceilposed has no DDS; dds.security.keystore cannot be used");
+  spdlog::error("DDS Security: {}", keystore_problem(config_));
   return kExitKeystore;
 #endif
 }
@@ -489,6 +502,16 @@ int Service::run() {
 int run_service(const ServiceConfig& config, const DaemonOptions& options) {
   Service service(config, options);
   return service.run();
+}
+
+std::string keystore_problem(const ServiceConfig& config) {
+  if (!config.dds.enabled || config.dds.security.keystore_dir.empty()) return {};
+#ifdef CEILPOSE_DAEMON_HAVE_DDS
+  auto files = checked_enclave(config);
+  return files ? std::string() : files.error().message;
+#else
+  return "this ceilposed was built without DDS; dds.security.keystore cannot be used";
+#endif
 }
 
 }  // namespace ceilpose::daemon

@@ -151,6 +151,24 @@ TEST_F(DaemonSecurity, AnEnclaveWhosePermissionsAreAnotherRobotsCannotPublish) {
   EXPECT_NE(r.err.find("must allow publishing rt/r1/*"), std::string::npos) << r.err;
 }
 
+// --check-config answers what start-up would: the keystore a file names is
+// checked too (exit 6), and a good one is valid.
+TEST_F(DaemonSecurity, CheckConfigChecksTheKeystoreTheFileNames) {
+  TestKeystore ks{"r1"};
+  const std::string config = write_temp_file(
+      "secure.yaml", "dds:\n  robot_name: r1\n  security:\n    keystore: \"" + ks.dir() + "\"\n");
+  auto good = run_daemon({"--check-config", config}, kBoundMs);
+  EXPECT_EQ(good.exit.code, daemon::kExitOk) << good.err;
+  EXPECT_NE(good.out.find(config + ": valid"), std::string::npos) << good.out;
+  std::filesystem::remove(ks.files("r1").governance);
+  auto bad = run_daemon({"--check-config", config}, kBoundMs);
+  EXPECT_EQ(bad.exit.code, daemon::kExitKeystore) << bad.err;
+  EXPECT_NE(bad.err.find("DDS Security: keystore " + ks.dir() + ": " + ks.files("r1").governance +
+                         ": cannot read signed governance document"),
+            std::string::npos)
+      << bad.err;
+}
+
 TEST_F(DaemonSecurity, AnEmptyKeystoreOptionIsAUsageError) {
   auto r = run_daemon({"--keystore", "", "--duration", "1", "--shm", shm_}, kBoundMs);
   EXPECT_EQ(r.exit.code, daemon::kExitUsage) << r.err;
