@@ -8,6 +8,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <filesystem>
 #include <fstream>
 #include <map>
 #include <sstream>
@@ -259,6 +260,41 @@ TEST_F(DaemonLifecycle, SighupSaysWhichKeysNeedARestart) {
   ASSERT_TRUE(daemon->wait(5000).has_value());
   EXPECT_NE(daemon->err().find("capture.fps changed but needs a restart"), std::string::npos)
       << daemon->err();
+}
+
+// Issue 15: when the configuration's path had become a directory, SIGHUP
+// silently returned every tuned key to its default. Now the running
+// configuration stays and the log says why.
+TEST_F(DaemonLifecycle, SighupOnAConfigThatBecameADirectoryKeepsTheTunedKeys) {
+  // Tuned so that no rectangle is large enough: a return to the default
+  // (150 px) would bring markers back.
+  { std::ofstream(config_) << config_text(1 << 23); }
+  auto daemon = start();
+  ASSERT_TRUE(notify_.wait_for("READY=1", kStartTimeoutMs)) << daemon->err();
+  auto reader = ShmPoseReader::open_waiting(shm_, 5000);
+  ASSERT_TRUE(reader) << reader.error().message;
+
+  ASSERT_TRUE(std::filesystem::remove(config_));
+  ASSERT_TRUE(std::filesystem::create_directory(config_));
+  daemon->signal(SIGHUP);
+  ASSERT_TRUE(notify_.wait_for("READY=1", 5000)) << "no READY=1 after RELOADING=1";
+
+  PoseRecord pose{};
+  pose.seq = reader->latest_seq() + 2;  // published after the reload
+  int most_markers = 0;
+  for (int i = 0; i < 30; ++i) {
+    pose = next_pose(*reader, pose.seq);
+    ASSERT_NE(pose.seq, 0u) << "stream stopped after SIGHUP\n" << daemon->err();
+    most_markers = std::max<int>(most_markers, pose.markers);
+  }
+  EXPECT_EQ(most_markers, 0) << "tuned keys returned to their defaults\n" << daemon->err();
+  EXPECT_NE(daemon->err().find("SIGHUP: keeping the running configuration: " + config_),
+            std::string::npos)
+      << daemon->err();
+  EXPECT_NE(daemon->err().find("it is a directory"), std::string::npos) << daemon->err();
+  daemon->signal(SIGTERM);
+  ASSERT_TRUE(daemon->wait(5000).has_value()) << daemon->err();
+  std::filesystem::remove(config_);
 }
 
 // A map that lists one marker only: every other decoded marker is unused.
