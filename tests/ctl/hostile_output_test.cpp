@@ -63,7 +63,6 @@ TEST_F(HostileOutput, CountsAndDurationsThatNeverEndAreUsageErrors) {
   EXPECT_NE(watch.err.find("--count: must be a whole number of at least 0, got '-1'"),
             std::string::npos)
       << watch.err;
-  if (!has_subcommand("fleet")) GTEST_SKIP() << "built without DDS";
   const CommandOutput fleet = run_ceilposectl({"fleet", "--duration", "nan"});
   EXPECT_EQ(fleet.exit_code, kExitUsage);
   EXPECT_NE(fleet.err.find("--duration: must be a number of seconds above 0, got 'nan'"),

@@ -15,7 +15,4 @@ using CommandOutput = RunOutput;
 CommandOutput run_ceilposectl(const std::vector<std::string>& args, int timeout_ms = 60'000,
                               int stdout_fd = -1);
 
-// True when this ceilposectl build has the sub-command.
-bool has_subcommand(const std::string& name);
-
 }  // namespace ceilpose::test

@@ -40,13 +40,8 @@ using namespace testing::xcheck;
 constexpr double kGrid_m = testing::xcheck::kGridUnit_m;
 constexpr double kPi = std::numbers::pi;
 
-// The binary sits at <build>/ctl/ceilposectl, this test at
-// <build>/tests/pipeline/pipeline_tests; CEILPOSECTL overrides.
-fs::path ceilposectl() {
-  if (const char* env = std::getenv("CEILPOSECTL")) return env;
-  return fs::read_symlink("/proc/self/exe").parent_path().parent_path().parent_path() / "ctl" /
-         "ceilposectl";
-}
+// Built before this test (tests/pipeline/CMakeLists.txt depends on it).
+fs::path ceilposectl() { return CEILPOSECTL_PATH; }
 
 // A scratch directory removed with the test.
 class ScratchDir {
@@ -249,10 +244,7 @@ std::vector<XPose> record_case(const LocateCase& c, const fs::path& recording) {
 
 class IndependentLocate : public ::testing::TestWithParam<LocateCase> {
  protected:
-  void SetUp() override {
-    if (!fs::exists(ceilposectl())) GTEST_SKIP() << ceilposectl() << " not built";
-    ASSERT_FALSE(scratch_.path().empty()) << "mkdtemp in /tmp failed";
-  }
+  void SetUp() override { ASSERT_FALSE(scratch_.path().empty()) << "mkdtemp in /tmp failed"; }
   ScratchDir scratch_;
 };
 
@@ -377,7 +369,6 @@ INSTANTIATE_TEST_SUITE_P(Recordings, IndependentLocate, ::testing::ValuesIn(loca
 // SPEC §4 allows greyscale PNG frames, but the markers are told apart by
 // colour: `locate` must read every frame, report no pose and exit 0.
 TEST(IndependentLocateGrey, GreyscalePngRecordingGivesNoPoseOnAnyFrame) {
-  if (!fs::exists(ceilposectl())) GTEST_SKIP() << ceilposectl() << " not built";
   ScratchDir scratch;
   ASSERT_FALSE(scratch.path().empty());
   for (const XCamera& camera : {XCamera{}, camera_320x240()}) {
