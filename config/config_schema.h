@@ -57,6 +57,14 @@ inline const char* check_no_space(const std::string& s) {
 
 inline constexpr double kPi = std::numbers::pi;
 
+// Sections SIGHUP applies live (is_live_key), and the keys in them that
+// still need a restart: the image size fixes buffers and the capture format.
+// with_live_keys() (config_writer.cpp) copies exactly these; a test checks
+// that for every key.
+inline constexpr std::array<const char*, 7> kLiveSections{
+    "camera", "mount", "ceiling", "detector", "positioning", "filter", "logging"};
+inline constexpr std::array<const char*, 2> kRestartKeys{"camera.width", "camera.height"};
+
 // Visitor V provides:
 //   section(name, fn)             a nested mapping
 //   field(name, int&/float&/double&/uint64_t&, min, max)
@@ -142,10 +150,12 @@ void describe(V& v, ServiceConfig& c) {
     v.field("blur_shift_full", d.blur_shift_full, 0.0f, 100.0f);
     v.field("sampling_blur_px", d.sampling_blur_px, 0.0f, 100.0f);
     v.field("max_blur_to_dot", d.max_blur_to_dot, 0.0f, 100.0f);
+    v.field("quality_full_margin", d.quality_full_margin, 0.001f, 1.0f);
+    v.field("quality_zero_pair_score", d.quality_zero_pair_score, 0.001f, 100.0f);
   });
   v.section("positioning", [&] {
     v.choice(
-        "mode", c.positioning_mode,
+        "mode", p.positioning.mode,
         Choices<PositioningMode>{
             {to_string(PositioningMode::kAuto).data(), PositioningMode::kAuto},
             {to_string(PositioningMode::kChangeOfAxes).data(), PositioningMode::kChangeOfAxes},
@@ -164,6 +174,13 @@ void describe(V& v, ServiceConfig& c) {
     v.field("lsq_max_tilt_rad", q.lsq_max_tilt_rad, 0.0, kPi / 2);
     v.field("lsq_tilt_min_markers", q.lsq_tilt_min_markers, 1, kMaxMarkersPerFrame);
     v.field("lsq_estimate_height", q.lsq_estimate_height);
+    v.field("lsq_max_rejections", q.lsq_max_rejections, 0, kMaxMarkersPerFrame);
+    v.field("lsq_motion_min_row_span", q.lsq_motion_min_row_span, 0.0, 1.0);
+    v.field("lsq_motion_min_markers", q.lsq_motion_min_markers, 1, kMaxMarkersPerFrame);
+    v.field("lsq_motion_prior_mps", q.lsq_motion_prior_mps, 1e-6, 100.0);
+    v.field("lsq_motion_prior_radps", q.lsq_motion_prior_radps, 1e-6, 100.0);
+    v.field("lsq_motion_prior_floor_mps", q.lsq_motion_prior_floor_mps, 0.0, 100.0);
+    v.field("lsq_motion_prior_floor_radps", q.lsq_motion_prior_floor_radps, 0.0, 100.0);
     v.field("grid_tolerance_units", q.grid_tolerance_units, 0.01, 0.5);
     v.field("heading_tolerance_rad", q.heading_tolerance_rad, 0.0, kPi);
     v.field("max_depth_scale_error", q.max_depth_scale_error, 0.0, 1.0);

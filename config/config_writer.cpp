@@ -157,6 +157,44 @@ std::vector<std::pair<std::string, std::string>> config_values(const ServiceConf
   return values;
 }
 
+bool is_live_key(std::string_view key) {
+  for (const char* restart : config_detail::kRestartKeys)
+    if (key == restart) return false;
+  for (const char* section : config_detail::kLiveSections) {
+    const std::string_view name(section);
+    if (key.size() > name.size() && key.substr(0, name.size()) == name && key[name.size()] == '.')
+      return true;
+  }
+  return false;
+}
+
+namespace {
+template <size_t N>
+std::string listed(const std::array<const char*, N>& names) {
+  std::string text;
+  for (size_t i = 0; i < N; ++i)
+    text += std::string(i == 0 ? "" : i + 1 == N ? " and " : ", ") + names[i];
+  return text;
+}
+}  // namespace
+
+std::string live_keys_phrase() {
+  return "the " + listed(config_detail::kLiveSections) + " keys live, but not " +
+         listed(config_detail::kRestartKeys);
+}
+
+ServiceConfig with_live_keys(const ServiceConfig& running, const ServiceConfig& next) {
+  // Whole structs, then the restart keys put back: the loaded map and
+  // camera files travel with pipeline and calibration.
+  ServiceConfig live = running;
+  live.pipeline = next.pipeline;
+  live.calibration = next.calibration;
+  live.pipeline.intrinsics.width = running.pipeline.intrinsics.width;
+  live.pipeline.intrinsics.height = running.pipeline.intrinsics.height;
+  live.logging = next.logging;
+  return live;
+}
+
 std::vector<std::string> changed_config_keys(const ServiceConfig& a, const ServiceConfig& b) {
   const auto va = config_values(a);
   const auto vb = config_values(b);

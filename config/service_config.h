@@ -70,7 +70,6 @@ struct ServiceConfig {
   // camera.calibration_file and ceiling.map: loaded into `pipeline` by
   // load_calibration_files at start and on every reload.
   CalibrationFiles calibration;
-  PositioningMode positioning_mode = PositioningMode::kAuto;
   CaptureConfig capture;
   ShmOptions ipc;  // the shared-memory segment: name, group, stale_after_ms
   DdsConfig dds;
@@ -115,6 +114,19 @@ Result<ServiceConfig> with_calibration_files(ServiceConfig config);
 // Key paths whose values differ (what a SIGHUP reload changes); also
 // "ceiling.map" when the map read from the same file has changed.
 std::vector<std::string> changed_config_keys(const ServiceConfig& a, const ServiceConfig& b);
+
+// What SIGHUP applies without a restart: the sections the pipeline thread
+// can take between two frames (config_schema.h's kLiveSections), less the
+// keys that fix buffers or the capture format (kRestartKeys). One table:
+// the daemon, config/ceilpose.yaml's comments, the unit's comment and
+// docs/service.md follow it (tests/config/live_keys_test.cpp).
+bool is_live_key(std::string_view key_path);
+// "the camera, mount, ... and logging keys live, but not camera.width and
+// camera.height": the phrase every text about SIGHUP carries.
+std::string live_keys_phrase();
+// `running` with every live key taken from `next` (the loaded map and
+// camera files with them), every other key left as it runs.
+ServiceConfig with_live_keys(const ServiceConfig& running, const ServiceConfig& next);
 
 // The configuration as YAML, every key present (`ceilposed --print-config`).
 std::string dump_config(const ServiceConfig& config);

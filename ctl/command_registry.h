@@ -8,20 +8,9 @@
 #include <string>
 #include <vector>
 
-namespace ceilpose::ctl {
+#include "core/exit_codes.h"
 
-// Documented exit codes of ceilposectl (see --help and README).
-enum ExitCode : int {
-  kExitOk = 0,
-  kExitFailure = 1,   // runtime error (I/O, device, DDS)
-  kExitUsage = 2,     // bad command line
-  kExitNoDaemon = 3,  // no daemon publishing, or its pose is stale
-  kExitBadInput = 4,  // malformed recording or configuration
-  // A keystore that cannot be made or used: a missing file, a broken
-  // signature, an expired certificate, a key that is not the certificate's.
-  // The same number as ceilposed's.
-  kExitKeystore = 6,
-};
+namespace ceilpose::ctl {
 
 using CommandFactory = void (*)(CLI::App& app);
 

@@ -17,18 +17,17 @@ int with_output_checked(int rc) {
   std::cout.flush();
   if (std::fflush(stdout) == 0 && !std::ferror(stdout) && std::cout.good()) return rc;
   std::fprintf(stderr, "ceilposectl: cannot write to stdout: %s\n", std::strerror(errno));
-  return rc == ceilpose::ctl::kExitOk ? ceilpose::ctl::kExitFailure : rc;
+  return rc == ceilpose::kExitOk ? ceilpose::kExitFailure : rc;
 }
 
 }  // namespace
 
 int main(int argc, char** argv) {
+  using namespace ceilpose;
   using namespace ceilpose::ctl;
   std::signal(SIGPIPE, SIG_IGN);
-  CLI::App app{
-      "ceilposectl — query the ceilpose daemon, record, render and localize offline.\n"
-      "Exit codes: 0 ok, 1 runtime error, 2 usage error, 3 no live daemon or stale pose,\n"
-      "4 malformed recording or configuration, 6 keystore refused (DDS Security)."};
+  CLI::App app{"ceilposectl — query the ceilpose daemon, record, render and localize offline.\n" +
+               exit_codes_help(Program::kCeilposectl)};
   app.require_subcommand(1);
   auto& commands = registered_commands();
   std::sort(commands.begin(), commands.end(),

@@ -6,7 +6,7 @@
 
 #include "capture/source_spec.h"
 #include "config/cli_checks.h"
-#include "daemon/exit_codes.h"
+#include "core/exit_codes.h"
 
 namespace ceilpose::daemon {
 namespace {
@@ -21,10 +21,8 @@ bool parse_command_line(int argc, char** argv, DaemonOptions* options, int* exit
       "ceilposed - localizes the robot from coded ceiling markers and publishes its pose\n"
       "on shared memory and DDS (ROS 2 PoseWithCovarianceStamped on rt/<robot>/pose).\n"
       "Command-line options override the configuration file; defaults are SPEC.md's.\n"
-      "Signals: SIGTERM/SIGINT stop cleanly, SIGHUP reloads the configuration file.\n"
-      "Exit codes: 0 ok, 1 runtime failure, 2 usage error, 3 bad configuration,\n"
-      "4 frame source failure, 5 shared-memory name held (another ceilposed, or another\n"
-      "user's file in /dev/shm), 6 keystore refused (DDS Security: names the file)."};
+      "Signals: SIGTERM/SIGINT stop cleanly, SIGHUP reloads the configuration file.\n" +
+      exit_codes_help(Program::kCeilposed)};
   app.set_version_flag("--version", "ceilposed 0.1.0");
 
   std::string source, robot, shm, log_level, keystore, enclave;

@@ -7,9 +7,9 @@
 #include <new>
 #include <system_error>
 
+#include "core/exit_codes.h"
 #include "core/resource_limits.h"
 #include "daemon/daemon_options.h"
-#include "daemon/exit_codes.h"
 #include "daemon/logging.h"
 #include "daemon/service.h"
 
@@ -19,7 +19,7 @@ namespace {
 int flushed(int exit_code) {
   if (std::fflush(stdout) != 0 || std::ferror(stdout)) {
     std::fprintf(stderr, "ceilposed: cannot write to stdout: %s\n", std::strerror(errno));
-    return ceilpose::daemon::kExitRuntime;
+    return ceilpose::kExitFailure;
   }
   return exit_code;
 }
@@ -66,7 +66,7 @@ int main(int argc, char** argv) {
   // 12 and 290 MiB crash inside Cyclone DDS. The needs leave a margin.
   if (const std::string limit = resource_limit_problem({32, 512}); !limit.empty()) {
     spdlog::critical("ceilposed: cannot start: {}", limit);
-    return kExitRuntime;
+    return kExitFailure;
   }
   try {
     return run_service(*config, options);
@@ -74,16 +74,16 @@ int main(int argc, char** argv) {
     spdlog::critical(
         "ceilposed: out of memory (the address-space limit, ulimit -v / LimitAS=, or the "
         "machine's memory; ceilposed needs about 400 MB of address space, docs/service.md)");
-    return kExitRuntime;
+    return kExitFailure;
   } catch (const std::system_error& e) {
     // std::thread reports a refused clone() as EAGAIN: "Resource temporarily unavailable".
     spdlog::critical(
         "ceilposed: cannot start: {} (thread stacks and buffers need about 400 MB of address "
         "space and a few threads: check ulimit -v / LimitAS= and ulimit -u / TasksMax=)",
         e.what());
-    return kExitRuntime;
+    return kExitFailure;
   } catch (const std::exception& e) {
     spdlog::critical("ceilposed: {}", e.what());
-    return kExitRuntime;
+    return kExitFailure;
   }
 }

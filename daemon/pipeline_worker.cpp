@@ -16,10 +16,6 @@ constexpr int kAcquireTimeoutMs = 50;  // bounds how late stop() and status are 
 // together do not give a rate from a handful of frames.
 constexpr int64_t kMinFpsWindowNs = 200'000'000;
 
-LocalizerOptions localizer_options(const ServiceConfig& config) {
-  return {config.positioning_mode, config.pipeline.filter.enabled};
-}
-
 }  // namespace
 
 PipelineWorker::PipelineWorker(const ServiceConfig& config, WorkerOptions options,
@@ -29,7 +25,7 @@ PipelineWorker::PipelineWorker(const ServiceConfig& config, WorkerOptions option
       capture_(capture),
       sinks_(sinks.begin(), sinks.end()),
       progress_(progress),
-      localizer_(config.pipeline, localizer_options(config)),
+      localizer_(config.pipeline),
       next_status_ns_(sinks.size(), 0) {}
 
 PipelineWorker::~PipelineWorker() { stop(); }
@@ -54,7 +50,7 @@ void PipelineWorker::stop() {
 
 void PipelineWorker::reload(const ServiceConfig& config, bool reset_filter) {
   std::lock_guard lock(pending_mutex_);
-  pending_ = Pending{config.pipeline, localizer_options(config), reset_filter};
+  pending_ = Pending{config.pipeline, reset_filter};
   has_pending_.store(true, std::memory_order_release);
 }
 
@@ -87,7 +83,7 @@ void PipelineWorker::apply_pending() {
   std::unique_lock lock(pending_mutex_, std::try_to_lock);
   if (!lock.owns_lock()) return;  // the control thread is writing; take it next frame
   if (!pending_) return;
-  localizer_.reconfigure(pending_->pipeline, pending_->localizer, pending_->reset_filter);
+  localizer_.reconfigure(pending_->pipeline, pending_->reset_filter);
   pending_.reset();
   has_pending_.store(false, std::memory_order_release);
 }

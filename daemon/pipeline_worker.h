@@ -85,7 +85,6 @@ class PipelineWorker {
  private:
   struct Pending {
     PipelineConfig pipeline;
-    LocalizerOptions localizer;
     bool reset_filter;
   };
 

@@ -20,7 +20,8 @@
 #include "capture/frame_source.h"
 #include "capture/source_spec.h"
 #include "core/clock.h"
-#include "daemon/exit_codes.h"
+#include "core/exit_codes.h"
+#include "daemon/dds_pose_sink.h"
 #include "daemon/logging.h"
 #include "daemon/pipeline_worker.h"
 #include "daemon/pose_printer.h"
@@ -29,30 +30,17 @@
 #include "daemon/signal_channel.h"
 #include "daemon/systemd_notifier.h"
 #include "daemon/watchdog_gate.h"
-#include "ipc/shm/shm_pose_writer.h"
-#include "sim/trajectory_camera.h"
-#ifdef CEILPOSE_DAEMON_HAVE_DDS
-#include "daemon/dds_pose_sink.h"
 #include "ipc/dds/dds_options.h"
 #include "ipc/dds/dds_pose_publisher.h"
+#include "ipc/shm/shm_pose_writer.h"
 #include "keystore/keystore.h"
-#endif
+#include "sim/trajectory_camera.h"
 
 namespace ceilpose::daemon {
 namespace {
 
 constexpr int64_t kMsNs = 1'000'000;
 constexpr int64_t kPrintPeriodNs = 100 * kMsNs;  // --print-poses: at most 10 lines a second
-
-// Keys SIGHUP applies without a restart: everything the pipeline thread can
-// take between two frames. The image size fixes buffers and the capture format.
-bool live_key(const std::string& key) {
-  if (key == "camera.width" || key == "camera.height") return false;
-  for (const char* prefix :
-       {"camera.", "mount.", "ceiling.", "detector.", "positioning.", "filter.", "logging."})
-    if (key.rfind(prefix, 0) == 0) return true;
-  return false;
-}
 
 // The configured source options at the calibrated frame size.
 capture::SourceOptions source_options(const ServiceConfig& c) {
@@ -74,7 +62,6 @@ std::shared_ptr<FrameGenerator> frame_generator(const ServiceConfig& c) {
   return std::make_shared<sim::TrajectoryCamera>(o);
 }
 
-#ifdef CEILPOSE_DAEMON_HAVE_DDS
 // The publisher's options as configured; an empty robot name is the host's,
 // as a ROS name.
 DdsOptions dds_options(const ServiceConfig& c) {
@@ -100,7 +87,6 @@ Result<DdsSecurityFiles> checked_enclave(const ServiceConfig& c) {
     return make_error("keystore " + c.dds.security.keystore_dir + ": " + files.error().message);
   return files;
 }
-#endif
 
 class Service {
  public:
@@ -147,12 +133,10 @@ class Service {
   uint64_t reported_truncations_ = 0;
   size_t reported_other_writers_ = 0;
   std::optional<ShmPoseSink> shm_sink_;
-#ifdef CEILPOSE_DAEMON_HAVE_DDS
   std::optional<DdsPosePublisher> dds_;
   std::optional<DdsPoseSink> dds_sink_;
   // The enclave's files once check_keystore() found them good; unset: plain DDS.
   std::optional<DdsSecurityFiles> dds_security_;
-#endif
   std::vector<PublishingSink*> sinks_;
   std::unique_ptr<PipelineWorker> worker_;
   int exit_code_ = kExitOk;
@@ -210,7 +194,7 @@ int Service::start_shared_memory() {
   if (!shm) {
     spdlog::error("shared memory: {}", shm.error().message);
     return code == shm::ShmErrc::kNameTaken || code == shm::ShmErrc::kLiveWriter ? kExitShmNameTaken
-                                                                                 : kExitRuntime;
+                                                                                 : kExitFailure;
   }
   shm_.emplace(std::move(shm).value());
   shm_sink_.emplace(&*shm_, config_.watchdog.status_interval_ms);
@@ -223,7 +207,6 @@ int Service::start_shared_memory() {
 int Service::check_keystore() {
   const DdsSecurityConfig& sec = config_.dds.security;
   if (!config_.dds.enabled || sec.keystore_dir.empty()) return kExitOk;
-#ifdef CEILPOSE_DAEMON_HAVE_DDS
   auto files = checked_enclave(config_);
   if (!files) {
     spdlog::error("DDS Security: {}", files.error().message);
@@ -233,14 +216,9 @@ int Service::check_keystore() {
   spdlog::info("DDS Security: enclave {} of keystore {} (authenticated, encrypted)",
                enclave_name(config_), sec.keystore_dir);
   return kExitOk;
-#else
-  spdlog::error("DDS Security: {}", keystore_problem(config_));
-  return kExitKeystore;
-#endif
 }
 
 int Service::start_dds() {
-#ifdef CEILPOSE_DAEMON_HAVE_DDS
   if (!config_.dds.enabled) return kExitOk;
   DdsOptions options = dds_options(config_);
   options.domain.security = dds_security_;
@@ -254,16 +232,13 @@ int Service::start_dds() {
   }
   if (!pub) {
     spdlog::error("DDS: {}", pub.error().message);
-    return kExitRuntime;
+    return kExitFailure;
   }
   dds_.emplace(std::move(pub).value());
   dds_sink_.emplace(&*dds_, config_.dds.status_period_ms);
   sinks_.push_back(&*dds_sink_);
   spdlog::info("DDS: domain {} topic {}, status every {} ms", dds_->domain_id(), dds_->pose_topic(),
                config_.dds.status_period_ms);
-#else
-  if (config_.dds.enabled) spdlog::warn("DDS: not built into this ceilposed; shared memory only");
-#endif
   return kExitOk;
 }
 
@@ -279,7 +254,8 @@ int Service::start_pipeline() {
         "CAP_SYS_NICE); running at normal priority",
         wopts.rt_priority);
   spdlog::info("ceilposed running: shared memory {}, positioning {}, filter {}{}", shm_->name(),
-               to_string(config_.positioning_mode), config_.pipeline.filter.enabled ? "on" : "off",
+               to_string(config_.pipeline.positioning.mode),
+               config_.pipeline.filter.enabled ? "on" : "off",
                worker_->realtime() ? ", pipeline SCHED_FIFO " + std::to_string(wopts.rt_priority)
                                    : std::string());
   return kExitOk;
@@ -396,7 +372,6 @@ void Service::loop() {
 }
 
 void Service::report_interference() {
-#ifdef CEILPOSE_DAEMON_HAVE_DDS
   if (dds_sink_ && dds_sink_->other_pose_writers() != reported_other_writers_) {
     const size_t before = reported_other_writers_;
     reported_other_writers_ = dds_sink_->other_pose_writers();
@@ -410,7 +385,6 @@ void Service::report_interference() {
       spdlog::info("DDS: {} has no other writer any more", dds_->pose_topic());
     }
   }
-#endif
   if (shm_ && shm_->truncations() != reported_truncations_) {
     reported_truncations_ = shm_->truncations();
     spdlog::error(
@@ -444,21 +418,15 @@ void Service::reload() {
   std::string applied, needs_restart;
   bool filter_changed = false;
   for (const auto& key : changed) {
-    std::string& list = live_key(key) ? applied : needs_restart;
+    std::string& list = is_live_key(key) ? applied : needs_restart;
     list += (list.empty() ? "" : ", ") + key;
     filter_changed = filter_changed || key.rfind("filter.", 0) == 0;
   }
   if (changed.empty()) {
     spdlog::info("SIGHUP: {} unchanged", options_.config_path);
   } else {
-    // Copy only the live keys, so the running config stays what really runs.
-    ServiceConfig live = config_;
-    live.pipeline = next->pipeline;
-    live.calibration = next->calibration;
-    live.pipeline.intrinsics.width = config_.pipeline.intrinsics.width;
-    live.pipeline.intrinsics.height = config_.pipeline.intrinsics.height;
-    live.positioning_mode = next->positioning_mode;
-    live.logging = next->logging;
+    // Only the live keys, so the running config stays what really runs.
+    const ServiceConfig live = with_live_keys(config_, *next);
     if (!applied.empty()) {
       worker_->reload(running_config(live), filter_changed);
       set_log_level(live.logging.level);
@@ -477,9 +445,7 @@ void Service::shutdown() {
   if (worker_) worker_->stop();
   if (capture_) capture_->stop();
   if (shm_) shm_->mark_stopped();
-#ifdef CEILPOSE_DAEMON_HAVE_DDS
   if (dds_) dds_->dispose();
-#endif
   if (worker_) {
     const capture::CaptureStats cs = capture_->stats();
     spdlog::info("stopped after {} frames ({} dropped, {} skipped)", worker_->frames(),
@@ -506,12 +472,8 @@ int run_service(const ServiceConfig& config, const DaemonOptions& options) {
 
 std::string keystore_problem(const ServiceConfig& config) {
   if (!config.dds.enabled || config.dds.security.keystore_dir.empty()) return {};
-#ifdef CEILPOSE_DAEMON_HAVE_DDS
   auto files = checked_enclave(config);
   return files ? std::string() : files.error().message;
-#else
-  return "this ceilposed was built without DDS; dds.security.keystore cannot be used";
-#endif
 }
 
 }  // namespace ceilpose::daemon

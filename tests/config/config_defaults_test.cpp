@@ -131,8 +131,7 @@ TEST(ConfigSchema, EveryDetectorParamHasAKey) {
 }
 
 TEST(ConfigSchema, EveryPositioningParamHasAKey) {
-  // positioning.mode is the daemon's choice of method, not a PositioningParams field.
-  EXPECT_EQ(keys_in_section("positioning"), member_count<PositioningParams>() + 1);
+  EXPECT_EQ(keys_in_section("positioning"), member_count<PositioningParams>());
 }
 
 TEST(ConfigSchema, EveryFilterParamHasAKey) {
@@ -220,7 +219,7 @@ TEST(ConfigSchema, EveryKeyIsBoundToTheOptionsOfTheModuleThatUsesIt) {
       "capture.source",                      // make_frame_source (daemon/service.cpp)
       "capture.pipeline_rt_priority",        // WorkerOptions::rt_priority
       "capture.synthetic_seed",              // the synthetic camera's sim::TrajectoryCamera
-      "positioning.mode",                    // LocalizerOptions::mode
+      "positioning.mode",                    // PositioningParams::mode
       "logging.level",                       // set_log_level
       "logging.problem_report_interval_ms",  // the problem line's period
       "watchdog.max_stall_ms",               // WatchdogGate
@@ -247,7 +246,7 @@ TEST(ConfigSchema, DumpLoadsBackUnchanged) {
   c.pipeline.intrinsics.fx = 612.25;
   c.dds.publisher.domain.peers = {"10.0.0.2", "10.0.0.3"};
   c.logging.level = LogLevel::kDebug;
-  c.positioning_mode = PositioningMode::kBarycentric;
+  c.pipeline.positioning.mode = PositioningMode::kBarycentric;
   const std::string text = dump_config(c);
   auto loaded = load_config_string(text, "dump");
   ASSERT_TRUE(loaded) << loaded.error().message;

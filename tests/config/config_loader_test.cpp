@@ -38,7 +38,7 @@ TEST(ConfigLoader, ReadsEnumsListsAndColours) {
       "ceiling:\n  red: [1, 2, 3]\nlogging:\n  level: debug\n",
       "t.yaml");
   ASSERT_TRUE(r) << r.error().message;
-  EXPECT_EQ(r->positioning_mode, PositioningMode::kLeastSquares);
+  EXPECT_EQ(r->pipeline.positioning.mode, PositioningMode::kLeastSquares);
   EXPECT_EQ(r->dds.publisher.reliability, DdsReliability::kBestEffort);
   EXPECT_EQ(r->dds.publisher.domain.peers, (std::vector<std::string>{"a", "b"}));
   EXPECT_EQ(r->pipeline.layout.red.g, 2);

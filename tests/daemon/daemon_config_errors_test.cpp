@@ -2,7 +2,7 @@
 // nothing started (no shared-memory segment).
 #include <gtest/gtest.h>
 
-#include "daemon/exit_codes.h"
+#include "core/exit_codes.h"
 #include "tests/daemon/daemon_process.h"
 
 namespace ceilpose::test {
@@ -28,7 +28,7 @@ class DaemonBadConfig : public ::testing::TestWithParam<BadConfig> {
 TEST_P(DaemonBadConfig, CheckConfigNamesTheProblemAndExitsThree) {
   const std::string file = path();
   auto r = run_daemon({"--check-config", file});
-  EXPECT_EQ(r.exit.code, daemon::kExitBadConfig);
+  EXPECT_EQ(r.exit.code, ceilpose::kExitBadConfig);
   EXPECT_NE(r.err.find(file + ":"), std::string::npos) << r.err;
   EXPECT_NE(r.err.find(GetParam().message), std::string::npos) << r.err;
 }
@@ -37,7 +37,7 @@ TEST_P(DaemonBadConfig, StartingRefusesBeforeCreatingAnything) {
   const std::string file = path();
   const std::string shm = unique_shm_name();
   auto r = run_daemon({"--config", file, "--shm", shm, "--no-dds"});
-  EXPECT_EQ(r.exit.code, daemon::kExitBadConfig);
+  EXPECT_EQ(r.exit.code, ceilpose::kExitBadConfig);
   EXPECT_NE(r.err.find(GetParam().message), std::string::npos) << r.err;
   EXPECT_FALSE(shm_exists(shm)) << "segment created despite a bad configuration";
 }
@@ -91,7 +91,7 @@ TEST(DaemonCommandLine, ABadMapStopsTheDaemonNamingTheMapAndTheEntry) {
        {std::vector<std::string>{"--check-config", config},
         std::vector<std::string>{"--config", config, "--shm", unique_shm_name(), "--no-dds"}}) {
     auto r = run_daemon(args);
-    EXPECT_EQ(r.exit.code, daemon::kExitBadConfig) << r.err;
+    EXPECT_EQ(r.exit.code, ceilpose::kExitBadConfig) << r.err;
     EXPECT_NE(r.err.find(map + ":4: markers[0] (code [9, 1]): code outside the ceiling's 8 x 8"),
               std::string::npos)
         << r.err;
@@ -101,19 +101,19 @@ TEST(DaemonCommandLine, ABadMapStopsTheDaemonNamingTheMapAndTheEntry) {
 TEST(DaemonCommandLine, ValidFileChecksOk) {
   auto r =
       run_daemon({"--check-config", std::string(CEILPOSE_SOURCE_DIR) + "/config/ceilpose.yaml"});
-  EXPECT_EQ(r.exit.code, daemon::kExitOk) << r.err;
+  EXPECT_EQ(r.exit.code, ceilpose::kExitOk) << r.err;
   EXPECT_NE(r.out.find("valid"), std::string::npos);
 }
 
 TEST(DaemonCommandLine, UnknownOptionExitsTwo) {
   auto r = run_daemon({"--frobnicate"});
-  EXPECT_EQ(r.exit.code, daemon::kExitUsage);
+  EXPECT_EQ(r.exit.code, ceilpose::kExitUsage);
 }
 
 TEST(DaemonCommandLine, BadOverrideNamesTheOptionAndExitsThree) {
   const std::string shm = unique_shm_name();
   auto r = run_daemon({"--shm", shm, "--domain", "999"});
-  EXPECT_EQ(r.exit.code, daemon::kExitBadConfig);
+  EXPECT_EQ(r.exit.code, ceilpose::kExitBadConfig);
   EXPECT_NE(r.err.find("--domain: dds.domain_id"), std::string::npos) << r.err;
   EXPECT_FALSE(shm_exists(shm));
 }
@@ -122,14 +122,14 @@ TEST(DaemonCommandLine, OptionsOverrideTheFile) {
   const std::string file = write_temp_file("c.yaml", "ipc:\n  shm_name: /from-file\n");
   auto r =
       run_daemon({"--config", file, "--shm", "/from-option", "--robot", "r2", "--print-config"});
-  ASSERT_EQ(r.exit.code, daemon::kExitOk) << r.err;
+  ASSERT_EQ(r.exit.code, ceilpose::kExitOk) << r.err;
   EXPECT_NE(r.out.find("shm_name: \"/from-option\""), std::string::npos) << r.out;
   EXPECT_NE(r.out.find("robot_name: \"r2\""), std::string::npos) << r.out;
 }
 
 TEST(DaemonCommandLine, HelpListsTheSpecOptionsAndExitCodes) {
   auto r = run_daemon({"--help"});
-  EXPECT_EQ(r.exit.code, daemon::kExitOk);
+  EXPECT_EQ(r.exit.code, ceilpose::kExitOk);
   for (const char* opt : {"--config", "--source", "--robot", "--shm", "--domain", "--duration",
                           "--check-config", "Exit codes"})
     EXPECT_NE(r.out.find(opt), std::string::npos) << opt;

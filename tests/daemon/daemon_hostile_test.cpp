@@ -8,7 +8,7 @@
 #include <string>
 #include <vector>
 
-#include "daemon/exit_codes.h"
+#include "core/exit_codes.h"
 #include "ipc/shm/shm_pose_writer.h"
 #include "tests/daemon/daemon_process.h"
 
@@ -46,7 +46,7 @@ TEST_F(DaemonHostile, AStdoutNobodyReadsNeitherHangsNorStopsTheRun) {
   close(fds[1]);
   ASSERT_TRUE(exit.has_value()) << "still running " << kBoundMs << " ms into a 1.5 s run";
   EXPECT_TRUE(exit->exited);
-  EXPECT_EQ(exit->code, daemon::kExitOk) << d.err();
+  EXPECT_EQ(exit->code, ceilpose::kExitOk) << d.err();
   EXPECT_NE(d.err().find("--print-poses: stdout is not being read; pose lines are dropped"),
             std::string::npos)
       << d.err();
@@ -65,7 +65,7 @@ TEST_F(DaemonHostile, AStdoutClosedByItsReaderEndsThePrintingNotTheDaemon) {
   close(fds[1]);
   ASSERT_TRUE(exit.has_value());
   EXPECT_TRUE(exit->exited) << "killed by signal " << exit->signal;
-  EXPECT_EQ(exit->code, daemon::kExitOk) << d.err();
+  EXPECT_EQ(exit->code, ceilpose::kExitOk) << d.err();
   EXPECT_NE(d.err().find("--print-poses: stdout was closed by its reader after 0 lines"),
             std::string::npos)
       << d.err();
@@ -78,7 +78,7 @@ TEST_F(DaemonHostile, PrintConfigIntoAFullDeviceFailsAndSaysSo) {
   const auto exit = d.wait(kBoundMs);
   close(full);
   ASSERT_TRUE(exit.has_value());
-  EXPECT_EQ(exit->code, daemon::kExitRuntime);
+  EXPECT_EQ(exit->code, ceilpose::kExitFailure);
   EXPECT_NE(d.err().find("ceilposed: cannot write to stdout: No space left on device"),
             std::string::npos)
       << d.err();
@@ -88,7 +88,7 @@ TEST_F(DaemonHostile, PrintConfigIntoAFullDeviceFailsAndSaysSo) {
 TEST_F(DaemonHostile, EmptyOptionValuesAreUsageErrorsNotDefaults) {
   for (const char* option : {"--source", "--shm", "--config", "--robot", "--check-config"}) {
     auto r = run_daemon(args({option, ""}), kBoundMs);
-    EXPECT_EQ(r.exit.code, daemon::kExitUsage) << option << ": " << r.err;
+    EXPECT_EQ(r.exit.code, ceilpose::kExitUsage) << option << ": " << r.err;
     EXPECT_NE(r.err.find(std::string(option) + ": must not be empty"), std::string::npos) << r.err;
     EXPECT_FALSE(shm_exists(shm_)) << option;
   }
@@ -97,7 +97,7 @@ TEST_F(DaemonHostile, EmptyOptionValuesAreUsageErrorsNotDefaults) {
 TEST_F(DaemonHostile, ADurationThatWouldNeverEndIsAUsageError) {
   for (const char* value : {"nan", "0", "-1", "inf", "1s"}) {
     auto r = run_daemon(args({"--duration", value}), kBoundMs);
-    EXPECT_EQ(r.exit.code, daemon::kExitUsage) << value << ": " << r.err;
+    EXPECT_EQ(r.exit.code, ceilpose::kExitUsage) << value << ": " << r.err;
     EXPECT_NE(r.err.find("--duration: must be a number of seconds above 0, got '" +
                          std::string(value) + "'"),
               std::string::npos)
@@ -112,7 +112,7 @@ TEST_F(DaemonHostile, ANameTakenInDevShmExitsFiveNamingWhatHoldsIt) {
   ASSERT_EQ(symlink("/etc/passwd", squat.c_str()), 0);
   auto r = run_daemon(args({"--duration", "1"}), kBoundMs);
   unlink(squat.c_str());
-  EXPECT_EQ(r.exit.code, daemon::kExitShmNameTaken) << r.err;
+  EXPECT_EQ(r.exit.code, ceilpose::kExitShmNameTaken) << r.err;
   EXPECT_NE(r.err.find(squat + " is a symbolic link owned by uid"), std::string::npos) << r.err;
 }
 

@@ -14,7 +14,7 @@
 #include <sstream>
 #include <thread>
 
-#include "daemon/exit_codes.h"
+#include "core/exit_codes.h"
 #include "ipc/shm/shm_pose_reader.h"
 #include "ipc/shm/shm_pose_writer.h"
 #include "tests/daemon/daemon_process.h"
@@ -123,7 +123,7 @@ TEST_F(DaemonLifecycle, SigtermStopsWithinASecondWithExitZeroAndSegmentMarkedSto
   ASSERT_TRUE(exit.has_value()) << "still running 5 s after SIGTERM";
   EXPECT_LE(took, milliseconds(1000));
   EXPECT_TRUE(exit->exited);
-  EXPECT_EQ(exit->code, daemon::kExitOk) << daemon->err();
+  EXPECT_EQ(exit->code, ceilpose::kExitOk) << daemon->err();
   EXPECT_EQ(reader->writer_info().state, WriterState::kStopped);
   EXPECT_EQ(reader->liveness(1000), Liveness::kStopped);
   EXPECT_TRUE(notify_.wait_for("STOPPING=1", 1000));
@@ -170,7 +170,7 @@ TEST_F(DaemonLifecycle, ANotifySocketNobodyReadsDoesNotHoldUpSigterm) {
   const auto exit = daemon->wait(5000);
   ASSERT_TRUE(exit.has_value()) << "still running 5 s after SIGTERM\n" << daemon->err();
   EXPECT_LE(Clock::now() - sent, milliseconds(1000));
-  EXPECT_EQ(exit->code, daemon::kExitOk) << daemon->err();
+  EXPECT_EQ(exit->code, ceilpose::kExitOk) << daemon->err();
   EXPECT_NE(daemon->err().find("its reader has stopped reading"), std::string::npos)
       << daemon->err();
 }
@@ -201,7 +201,7 @@ TEST_F(DaemonLifecycle, TruncatingTheSegmentKillsNeitherTheDaemonNorItsReaders) 
   daemon->signal(SIGTERM);
   const auto exit = daemon->wait(5000);
   ASSERT_TRUE(exit.has_value()) << daemon->err();
-  EXPECT_EQ(exit->code, daemon::kExitOk) << daemon->err();
+  EXPECT_EQ(exit->code, ceilpose::kExitOk) << daemon->err();
 }
 
 TEST_F(DaemonLifecycle, SigintStopsCleanlyToo) {
@@ -211,7 +211,7 @@ TEST_F(DaemonLifecycle, SigintStopsCleanlyToo) {
   auto exit = daemon->wait(5000);
   ASSERT_TRUE(exit.has_value());
   EXPECT_TRUE(exit->exited);
-  EXPECT_EQ(exit->code, daemon::kExitOk);
+  EXPECT_EQ(exit->code, ceilpose::kExitOk);
 }
 
 TEST_F(DaemonLifecycle, SighupAppliesANewThresholdWithoutDroppingTheStream) {
@@ -369,7 +369,7 @@ TEST_F(DaemonLifecycle, PublishesOnDdsAndDisposesOnSigterm) {
   dds_daemon.signal(SIGTERM);
   auto exit = dds_daemon.wait(5000);
   ASSERT_TRUE(exit.has_value());
-  EXPECT_EQ(exit->code, daemon::kExitOk) << dds_daemon.err();
+  EXPECT_EQ(exit->code, ceilpose::kExitOk) << dds_daemon.err();
   EXPECT_NE(dds_daemon.err().find("topic rt/testbot/pose"), std::string::npos) << dds_daemon.err();
   EXPECT_EQ(dds_daemon.err().find("also publish"), std::string::npos)
       << "its own writers are not another robot's: " << dds_daemon.err();
@@ -406,12 +406,12 @@ TEST_F(DaemonLifecycle, TwoDaemonsWithOneRobotNameOnDdsEachWarn) {
 TEST_F(DaemonLifecycle, DurationEndsTheRunWithExitZero) {
   auto r = run_daemon({"--config", config_, "--shm", shm_, "--duration", "1"});
   EXPECT_TRUE(r.exit.exited);
-  EXPECT_EQ(r.exit.code, daemon::kExitOk) << r.err;
+  EXPECT_EQ(r.exit.code, ceilpose::kExitOk) << r.err;
 }
 
 TEST_F(DaemonLifecycle, LogsWithJournalPrioritiesAndNoTimestampsWhenNotATerminal) {
   auto r = run_daemon({"--config", config_, "--shm", shm_, "--duration", "0.5"});
-  ASSERT_EQ(r.exit.code, daemon::kExitOk) << r.err;
+  ASSERT_EQ(r.exit.code, ceilpose::kExitOk) << r.err;
   std::istringstream lines(r.err);
   int count = 0;
   for (std::string line; std::getline(lines, line); ++count) {
@@ -426,7 +426,7 @@ TEST_F(DaemonLifecycle, LogsWithJournalPrioritiesAndNoTimestampsWhenNotATerminal
 
 TEST_F(DaemonLifecycle, PrintPosesShowsGroundTruthAndErrorForTheSyntheticSource) {
   auto r = run_daemon({"--config", config_, "--shm", shm_, "--duration", "1.5", "--print-poses"});
-  ASSERT_EQ(r.exit.code, daemon::kExitOk) << r.err;
+  ASSERT_EQ(r.exit.code, ceilpose::kExitOk) << r.err;
   std::istringstream lines(r.out);
   int with_truth = 0, total = 0;
   for (std::string line; std::getline(lines, line); ++total)
@@ -438,7 +438,7 @@ TEST_F(DaemonLifecycle, PrintPosesShowsGroundTruthAndErrorForTheSyntheticSource)
 
 TEST_F(DaemonLifecycle, MissingReplayExitsFourWithoutCreatingTheSegment) {
   auto r = run_daemon({"--config", config_, "--shm", shm_, "--source", "replay:/nonexistent/rec"});
-  EXPECT_EQ(r.exit.code, daemon::kExitSourceFailure) << r.err;
+  EXPECT_EQ(r.exit.code, ceilpose::kExitSourceFailure) << r.err;
   EXPECT_NE(r.err.find("/nonexistent/rec"), std::string::npos) << r.err;
   EXPECT_FALSE(shm_exists(shm_));
 }

@@ -9,7 +9,7 @@
 #include <fstream>
 #include <sstream>
 
-#include "daemon/exit_codes.h"
+#include "core/exit_codes.h"
 #include "ipc/shm/shm_pose_writer.h"
 #include "recording/recording_writer.h"
 #include "sim/renderer.h"
@@ -56,7 +56,7 @@ TEST(DaemonReplay, LocalizesWithTheRecordingsCameraNotTheConfiguredOne) {
                        "--duration", "2.5"});
   (void)ShmPoseWriter::remove(shm);
   std::filesystem::remove_all(dir);
-  ASSERT_EQ(r.exit.code, daemon::kExitOk) << r.err;
+  ASSERT_EQ(r.exit.code, ceilpose::kExitOk) << r.err;
   EXPECT_NE(r.err.find("camera model from the recording: 320x240"), std::string::npos) << r.err;
   // --print-poses lines end in "err <position error> mm ...".
   std::istringstream lines(r.out);
@@ -85,7 +85,7 @@ TEST(DaemonReplay, HeightsTheMarkersContradictGiveNoPoseAndAReasonInTheLog) {
   (void)ShmPoseWriter::remove(shm);
   std::filesystem::remove_all(dir);
   std::filesystem::remove(config);
-  ASSERT_EQ(r.exit.code, daemon::kExitOk) << r.err;
+  ASSERT_EQ(r.exit.code, ceilpose::kExitOk) << r.err;
   EXPECT_NE(r.err.find("frames refused because the markers' spacing contradicts the configured "
                        "heights (check ceiling.height_m and mount.lens_height_m)"),
             std::string::npos)

@@ -11,8 +11,8 @@
 #include <string>
 #include <vector>
 
+#include "core/exit_codes.h"
 #include "core/text_file.h"
-#include "daemon/exit_codes.h"
 #include "ipc/shm/shm_pose_writer.h"
 #include "tests/daemon/daemon_process.h"
 #include "tests/ipc/dds/dds_test_env.h"
@@ -41,7 +41,7 @@ class DaemonSecurity : public ::testing::Test {
   // Runs a daemon that must refuse `keystore` and returns what it logged.
   std::string refused(const std::string& keystore, const std::string& robot = "r1") {
     auto r = run_daemon(args(keystore, robot, {"--duration", "5"}), kBoundMs, env_);
-    EXPECT_EQ(r.exit.code, daemon::kExitKeystore) << r.err;
+    EXPECT_EQ(r.exit.code, ceilpose::kExitKeystore) << r.err;
     EXPECT_FALSE(shm_exists(shm_)) << "the daemon started its outputs before it refused";
     EXPECT_EQ(r.err.find("capture:"), std::string::npos) << "the camera was opened: " << r.err;
     return r.err;
@@ -94,7 +94,7 @@ TEST_F(DaemonSecurity, ASecureDaemonIsSeenByASecureFleetAndNotByAPlainOne) {
   daemon.signal(SIGTERM);
   auto exit = daemon.wait(5000);
   ASSERT_TRUE(exit.has_value()) << daemon.err();
-  EXPECT_EQ(exit->code, daemon::kExitOk) << daemon.err();
+  EXPECT_EQ(exit->code, ceilpose::kExitOk) << daemon.err();
 }
 
 TEST_F(DaemonSecurity, ATamperedPermissionsFileStopsTheDaemonNamingIt) {
@@ -144,7 +144,7 @@ TEST_F(DaemonSecurity, AMissingFileOrEnclaveStopsTheDaemonNamingIt) {
 TEST_F(DaemonSecurity, AnEnclaveWhosePermissionsAreAnotherRobotsCannotPublish) {
   TestKeystore ks{"r1", "r2"};
   auto r = run_daemon(args(ks.dir(), "r1", {"--enclave", "r2", "--duration", "5"}), kBoundMs, env_);
-  EXPECT_EQ(r.exit.code, daemon::kExitKeystore) << r.err;
+  EXPECT_EQ(r.exit.code, ceilpose::kExitKeystore) << r.err;
   EXPECT_NE(r.err.find("rt/r1/pose on domain " + domain_ + ": Not Allowed By Security"),
             std::string::npos)
       << r.err;
@@ -158,11 +158,11 @@ TEST_F(DaemonSecurity, CheckConfigChecksTheKeystoreTheFileNames) {
   const std::string config = write_temp_file(
       "secure.yaml", "dds:\n  robot_name: r1\n  security:\n    keystore: \"" + ks.dir() + "\"\n");
   auto good = run_daemon({"--check-config", config}, kBoundMs);
-  EXPECT_EQ(good.exit.code, daemon::kExitOk) << good.err;
+  EXPECT_EQ(good.exit.code, ceilpose::kExitOk) << good.err;
   EXPECT_NE(good.out.find(config + ": valid"), std::string::npos) << good.out;
   std::filesystem::remove(ks.files("r1").governance);
   auto bad = run_daemon({"--check-config", config}, kBoundMs);
-  EXPECT_EQ(bad.exit.code, daemon::kExitKeystore) << bad.err;
+  EXPECT_EQ(bad.exit.code, ceilpose::kExitKeystore) << bad.err;
   EXPECT_NE(bad.err.find("DDS Security: keystore " + ks.dir() + ": " + ks.files("r1").governance +
                          ": cannot read signed governance document"),
             std::string::npos)
@@ -171,7 +171,7 @@ TEST_F(DaemonSecurity, CheckConfigChecksTheKeystoreTheFileNames) {
 
 TEST_F(DaemonSecurity, AnEmptyKeystoreOptionIsAUsageError) {
   auto r = run_daemon({"--keystore", "", "--duration", "1", "--shm", shm_}, kBoundMs);
-  EXPECT_EQ(r.exit.code, daemon::kExitUsage) << r.err;
+  EXPECT_EQ(r.exit.code, ceilpose::kExitUsage) << r.err;
 }
 
 }  // namespace
