@@ -1,5 +1,6 @@
 #include "core/camera_model.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 
@@ -38,16 +39,28 @@ Mat3 tilt_rotation(double tilt_x_rad, double tilt_y_rad) {
   return mat_mul(rx, ry);
 }
 
+Mat3 level_rotation(double yaw_rad) {
+  const double s = std::sin(yaw_rad), c = std::cos(yaw_rad);
+  return {-s, -c, 0.0, c, -s, 0.0, 0.0, 0.0, 1.0};
+}
+
+// R = Level(ψ)·Rx(a)·Ry(b) has Yc = (−cos a·cos ψ, −cos a·sin ψ, sin a).
+double camera_yaw_of(const Mat3& r) { return std::atan2(-r[4], -r[1]); }
+
+// M = Level(ψ)ᵀR = Rx(a)Ry(b) = [[cb, 0, sb], [sa·sb, ca, −sa·cb], [−ca·sb, sa, ca·cb]].
+void camera_tilt_of(const Mat3& r, double* a, double* b) {
+  const Mat3 m = mat_mul(mat_transpose(level_rotation(camera_yaw_of(r))), r);
+  *a = std::atan2(-m[5], m[8]);
+  *b = std::asin(std::clamp(m[2], -1.0, 1.0));
+}
+
 CameraPose camera_pose_from_robot(const Pose2D& robot, const CameraMount& mount) {
   double ox_m = 0.0, oy_m = 0.0;
   mount_offset_world(mount, robot.yaw_rad, &ox_m, &oy_m);
   CameraPose pose;
   pose.t_w = {robot.x_m + ox_m, robot.y_m + oy_m, mount.lens_height_m};
-  const double cam_yaw = robot.yaw_rad + mount.yaw_rad;
-  const double cy = std::cos(cam_yaw), sy = std::sin(cam_yaw);
-  // Columns Xc, Yc, Zc of the level camera (SPEC §3).
-  const Mat3 level{-sy, -cy, 0.0, cy, -sy, 0.0, 0.0, 0.0, 1.0};
-  pose.r_wc = mat_mul(level, tilt_rotation(mount.tilt_x_rad, mount.tilt_y_rad));
+  pose.r_wc = mat_mul(level_rotation(robot.yaw_rad + mount.yaw_rad),
+                      tilt_rotation(mount.tilt_x_rad, mount.tilt_y_rad));
   return pose;
 }
 

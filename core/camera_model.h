@@ -66,12 +66,65 @@ struct CameraPose {
   Vec3 t_w{};   // optical centre in the world
 };
 
-// SPEC §3: level camera axes Xc=(-sin yaw, cos yaw, 0), Yc=(-cos yaw, -sin yaw, 0),
-// Zc=(0,0,1), with the mount offset, mounting yaw and tilt applied.
-CameraPose camera_pose_from_robot(const Pose2D& robot, const CameraMount& mount);
+// ---- The camera's geometry (SPEC §3), written once. Every positioning
+// mode, the survey and calibration call these; templates serve Ceres'
+// automatic derivatives.
+//
+// The level camera of yaw ψ (image up's heading on the floor) has world axes
+// Xc = (−sin ψ, cos ψ, 0), Yc = (−cos ψ, −sin ψ, 0), Zc = (0, 0, 1). A tilted
+// camera is R_wc = Level(ψ)·Rx(a)·Ry(b): tilt a about Xc, then b about Yc.
+
+// A world offset (dx, dy) from the optical centre in the level camera's
+// (X, Y): X = −sin ψ·dx + cos ψ·dy, Y = −cos ψ·dx − sin ψ·dy.
+template <typename T>
+void world_to_level(const T& cos_yaw, const T& sin_yaw, const T& dx, const T& dy, T* x, T* y) {
+  *x = -sin_yaw * dx + cos_yaw * dy;
+  *y = -cos_yaw * dx - sin_yaw * dy;
+}
+
+// The inverse (the transpose): dx = −sin ψ·X − cos ψ·Y, dy = cos ψ·X − sin ψ·Y.
+template <typename T>
+void level_to_world(const T& cos_yaw, const T& sin_yaw, const T& x, const T& y, T* dx, T* dy) {
+  *dx = -sin_yaw * x - cos_yaw * y;
+  *dy = cos_yaw * x - sin_yaw * y;
+}
+
+// A point (lx, ly, lz) of the level camera's frame in the tilted camera's:
+// Ry(b)ᵀ·Rx(a)ᵀ·l.
+template <typename T>
+void level_to_tilted(const T& tilt_x_rad, const T& tilt_y_rad, const T& lx, const T& ly,
+                     const T& lz, T* px, T* py, T* pz) {
+  using std::cos;
+  using std::sin;
+  const T ca = cos(tilt_x_rad), sa = sin(tilt_x_rad), cb = cos(tilt_y_rad), sb = sin(tilt_y_rad);
+  const T q1 = ca * ly + sa * lz, q2 = -sa * ly + ca * lz;
+  *px = cb * lx - sb * q2;
+  *py = q1;
+  *pz = sb * lx + cb * q2;
+}
+
+// The level camera's rotation Level(ψ), row-major (columns Xc, Yc, Zc).
+Mat3 level_rotation(double yaw_rad);
 
 // Rotation about Xc by a, then about Yc by b, composed as R = Rx(a) * Ry(b).
 Mat3 tilt_rotation(double tilt_x_rad, double tilt_y_rad);
+
+// The yaw ψ of R_wc = Level(ψ)·Rx(a)·Ry(b): the floor heading of −Yc (image
+// up), exact for any tilt below 90°.
+double camera_yaw_of(const Mat3& r_wc);
+
+// The tilt (a, b) of R_wc = Level(ψ)·Rx(a)·Ry(b).
+void camera_tilt_of(const Mat3& r_wc, double* tilt_x_rad, double* tilt_y_rad);
+
+// SPEC §3 with the mount offset, mounting yaw and tilt applied.
+CameraPose camera_pose_from_robot(const Pose2D& robot, const CameraMount& mount);
+
+// A pixel residual in undistorted normalized coordinates: f·(observed −
+// X/Z), one axis. Undistorting the observations once is cheaper than
+// distorting every projection, and differentiates more simply.
+inline double normalized_residual_px(double f_px, double observed_n, double p_axis, double p_z) {
+  return f_px * (observed_n - p_axis / p_z);
+}
 
 Mat3 mat_mul(const Mat3& a, const Mat3& b);
 Mat3 mat_transpose(const Mat3& a);

@@ -91,13 +91,34 @@ struct MotionEstimate {
   double horizon_ms = 0.0;  // how far from time_ns a consumer may carry it
 };
 
+// Whether t_ns is within the estimate's horizon of its instant: the one
+// rule for every consumer (the pose client, the filter's readout motion,
+// `locate --predict-ms`). In double: an int64 difference of arbitrary
+// instants cannot overflow it; NaN is never within.
+inline bool within_horizon(const MotionEstimate& m, int64_t t_ns) {
+  const double dt_ms = (static_cast<double>(t_ns) - static_cast<double>(m.time_ns)) * 1e-6;
+  return std::abs(dt_ms) <= m.horizon_ms;
+}
+
 // The estimate carried to t_ns: pose (yaw wrapped) and rates with their
 // covariance (orders 0 and 1 only; the accelerations stay as they were).
+// No horizon check: callers that may be asked beyond it use predict_motion.
 inline MotionState motion_at(const MotionEstimate& m, int64_t t_ns) {
   MotionState out = m.state;
   propagate_motion(m.state, static_cast<double>(t_ns - m.time_ns) * 1e-9, m.jerk, &out, 2);
   out.x[2] = wrap_angle_rad(out.x[2]);
   return out;
+}
+
+enum class PredictOutcome { kOk, kNoMotion, kBeyondHorizon };
+
+// motion_at with the checks every prediction makes: an estimate without
+// motion, or an instant beyond its horizon, is refused (*out untouched).
+inline PredictOutcome predict_motion(const MotionEstimate& m, int64_t t_ns, MotionState* out) {
+  if (!m.valid) return PredictOutcome::kNoMotion;
+  if (!within_horizon(m, t_ns)) return PredictOutcome::kBeyondHorizon;
+  *out = motion_at(m, t_ns);
+  return PredictOutcome::kOk;
 }
 
 }  // namespace ceilpose

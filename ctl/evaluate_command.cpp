@@ -106,7 +106,7 @@ void add_evaluate_command(CLI::App& app) {
     });
     // Two frames at 30 fps: the age of a pose when a controller reads it (docs/latency.md).
     MotionAccuracySink motion(args->predict_ms.value_or(66.667));
-    const bool filtered = setup.localizer.filter;
+    const bool filtered = setup.config.filter.enabled;
     if (rc == kExitOk) {
       PoseSink* sinks[] = {&accuracy, &motion};
       rc =

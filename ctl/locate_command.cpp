@@ -98,7 +98,7 @@ void add_locate_command(CLI::App& app) {
     ReplaySetup setup;
     int rc = prepare_replay(*args, "locate", &setup);
     if (rc == kExitOk) {
-      JsonLinesSink out(setup.localizer.mode, args->predict_ms);
+      JsonLinesSink out(setup.config.positioning.mode, args->predict_ms);
       AnnotateSink annotate(*annotate_dir, *annotate_refused);
       std::vector<PoseSink*> sinks{&out};
       if (!annotate_dir->empty()) {

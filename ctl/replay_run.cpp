@@ -3,6 +3,7 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <utility>
 #include <vector>
@@ -76,7 +77,7 @@ int prepare_replay(const ReplayArgs& args, const char* command, ReplaySetup* set
       return kExitBadInput;
     }
     setup->config = loaded->pipeline;
-    mode = loaded->positioning_mode;
+    mode = loaded->pipeline.positioning.mode;
     files = loaded->calibration;
   }
   if (!args.calibration.camera_file.empty()) files.camera_file = args.calibration.camera_file;
@@ -86,7 +87,18 @@ int prepare_replay(const ReplayArgs& args, const char* command, ReplaySetup* set
                  args.mode_text.c_str(), positioning_mode_list().c_str());
     return kExitUsage;
   }
-  setup->localizer = LocalizerOptions{mode, args.filter || args.predict_ms.has_value()};
+  setup->config.positioning.mode = mode;
+  setup->config.filter.enabled = args.filter || args.predict_ms.has_value();
+  // The one horizon rule (core/motion_model.h): a prediction further than
+  // the filter's horizon is refused by every client, so here too. NaN fails.
+  const double horizon_ms = setup->config.filter.predict_horizon_ms;
+  if (args.predict_ms && !(std::abs(*args.predict_ms) <= horizon_ms)) {
+    std::fprintf(stderr,
+                 "ceilposectl %s: --predict-ms %g: beyond the filter's horizon of %g ms "
+                 "(filter.predict_horizon_ms; raise it with --config)\n",
+                 command, *args.predict_ms, horizon_ms);
+    return kExitUsage;
+  }
   auto reader = RecordingReader::open(args.dir);
   if (!reader.ok()) {
     std::fprintf(stderr, "ceilposectl %s: %s\n", command, reader.error().message.c_str());
@@ -110,7 +122,7 @@ int prepare_replay(const ReplayArgs& args, const char* command, ReplaySetup* set
 int run_replay(const ReplayArgs& args, const char* command, const ReplaySetup& setup,
                std::span<PoseSink* const> sinks) {
   const RecordingReader& reader = *setup.reader;
-  Localizer localizer(setup.config, setup.localizer);
+  Localizer localizer(setup.config);
   FramePrefetcher frames(reader, args.decode_threads);
   const size_t total = reader.rows().size();
   HeightsCheck heights(total);

@@ -34,7 +34,6 @@ void add_replay_options(CLI::App* cmd, ReplayArgs* args);
 
 struct ReplaySetup {
   PipelineConfig config;
-  LocalizerOptions localizer;
   std::optional<RecordingReader> reader;
 };
 

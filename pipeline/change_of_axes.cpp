@@ -2,34 +2,7 @@
 
 #include <cmath>
 
-#include "pipeline/pipeline_config.h"
-
 namespace ceilpose {
-
-ViewGeometry::ViewGeometry(const PipelineConfig& config)
-    : intrinsics_(config.intrinsics),
-      mount_(config.mount),
-      layout_(config.layout),
-      map_(config.map ? *config.map : CeilingMap(config.layout)),
-      depth_m_(config.layout.height_m - config.mount.lens_height_m),
-      tilt_(tilt_rotation(config.mount.tilt_x_rad, config.mount.tilt_y_rad)) {}
-
-void ViewGeometry::level_normalized(double u_px, double v_px, double* x_n, double* y_n) const {
-  double x = 0.0, y = 0.0;
-  undistort_pixel(intrinsics_, u_px, v_px, &x, &y);
-  // The camera axes in the world are Level(yaw)·tilt (core/camera_model.cpp),
-  // so tilt·ray is the ray in the level camera's frame.
-  const Vec3 r = mat_vec(tilt_, {x, y, 1.0});
-  *x_n = r[0] / r[2];
-  *y_n = r[1] / r[2];
-}
-
-Pose2D ViewGeometry::robot_from_camera(double cam_x_m, double cam_y_m, double cam_yaw_rad) const {
-  const double yaw = wrap_angle_rad(cam_yaw_rad - mount_.yaw_rad);
-  double ox_m = 0.0, oy_m = 0.0;
-  mount_offset_world(mount_, yaw, &ox_m, &oy_m);
-  return Pose2D{cam_x_m - ox_m, cam_y_m - oy_m, yaw};
-}
 
 namespace {
 
@@ -44,15 +17,14 @@ void centre_row_normalized(const ViewGeometry& view, const CameraMotion& motion,
   if (!motion.valid) return;
   const double tau_s = row_time_s(view.intrinsics(), v_px);
   const double depth_m = view.depth_m();
-  // Offset from the camera at tau, world frame (SPEC §3 level axes).
-  const double st = std::sin(cam_yaw_rad), ct = std::cos(cam_yaw_rad);
-  const double xc = depth_m * *x_n, yc = depth_m * *y_n;
-  const double dx = -st * xc - ct * yc + motion.vx_mps * tau_s;
-  const double dy = ct * xc - st * yc + motion.vy_mps * tau_s;
+  // Offset from the camera at tau, world frame, then seen from the centre
+  // row's camera.
+  double dx = 0.0, dy = 0.0;
+  view.ceiling_offset(cam_yaw_rad, *x_n, *y_n, &dx, &dy);
+  dx += motion.vx_mps * tau_s;
+  dy += motion.vy_mps * tau_s;
   const double yaw0 = cam_yaw_rad - motion.yaw_rate_radps * tau_s;
-  const double s0 = std::sin(yaw0), c0 = std::cos(yaw0);
-  *x_n = (-s0 * dx + c0 * dy) / depth_m;
-  *y_n = (-c0 * dx - s0 * dy) / depth_m;
+  world_to_level(std::cos(yaw0), std::sin(yaw0), dx / depth_m, dy / depth_m, x_n, y_n);
 }
 
 }  // namespace
@@ -102,10 +74,10 @@ bool marker_fix(const ViewGeometry& view, const MarkerObservation& marker, int i
   fix->placement = placement;
   fix->world_x_m = placement->x_m;
   fix->world_y_m = placement->y_m;
-  const double s = std::sin(fix->cam_yaw_rad), c = std::cos(fix->cam_yaw_rad);
-  const double xc = view.depth_m() * fix->centre_x_n, yc = view.depth_m() * fix->centre_y_n;
-  fix->cam_x_m = fix->world_x_m - (-s * xc - c * yc);
-  fix->cam_y_m = fix->world_y_m - (c * xc - s * yc);
+  double dx = 0.0, dy = 0.0;
+  view.ceiling_offset(fix->cam_yaw_rad, fix->centre_x_n, fix->centre_y_n, &dx, &dy);
+  fix->cam_x_m = fix->world_x_m - dx;
+  fix->cam_y_m = fix->world_y_m - dy;
   return true;
 }
 

@@ -117,6 +117,13 @@ struct DetectorParams {
   // 0.5 px; 640×480 frames under the stress levels measure ≤ 0.5 of the dot,
   // 320×240 ones mostly 0.4–0.7.
   float max_blur_to_dot = 0.75f;
+  // A marker's quality (0..1, `MarkerObservation::quality`) is the product
+  // of its dots' read margin over this margin (full quality at or above it)
+  // and of its pairing score below quality_zero_pair_score (0 there). A lone
+  // marker needs quality 0.5 to give a pose; lower this margin to trust
+  // fainter dots.
+  float quality_full_margin = 0.3f;
+  float quality_zero_pair_score = 4.0f;
 };
 
 }  // namespace ceilpose

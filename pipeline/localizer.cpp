@@ -7,16 +7,17 @@
 
 namespace ceilpose {
 
-Localizer::Localizer(const PipelineConfig& config, LocalizerOptions options)
-    : pipeline_(config),
-      options_(options),
-      filter_(config.filter),
-      result_(std::make_unique<FrameResult>()) {}
+PipelineConfig with_mode(PipelineConfig config, PositioningMode mode, bool filter) {
+  config.positioning.mode = mode;
+  config.filter.enabled = filter;
+  return config;
+}
 
-void Localizer::reconfigure(const PipelineConfig& config, LocalizerOptions options,
-                            bool reset_filter) {
+Localizer::Localizer(const PipelineConfig& config)
+    : pipeline_(config), filter_(config.filter), result_(std::make_unique<FrameResult>()) {}
+
+void Localizer::reconfigure(const PipelineConfig& config, bool reset_filter) {
   pipeline_.set_config(config);
-  options_ = options;
   if (reset_filter) {
     filter_ = TemporalFilter(config.filter);
     had_fix_ = false;
@@ -26,7 +27,10 @@ void Localizer::reconfigure(const PipelineConfig& config, LocalizerOptions optio
 const Localization& Localizer::localize(const ImageView& image, const FrameInfo& frame) {
   const int64_t start_ns = monotonic_ns();
   // 1. The frame on its own.
-  pipeline_.process(image, options_.mode, result_.get(), readout_motion(frame.timestamp_ns));
+  const PipelineConfig& config = pipeline_.config();
+  const bool filter = config.filter.enabled;
+  pipeline_.process(image, config.positioning.mode, result_.get(),
+                    readout_motion(frame.timestamp_ns));
   out_.frame = frame;
   out_.measured = result_->estimate;
   out_.markers_decoded = result_->marker_count;
@@ -37,20 +41,13 @@ const Localization& Localizer::localize(const ImageView& image, const FrameInfo&
   out_.stage_ns = result_->stage_ns;
 
   // 2. Over time (the frame's own time, so processing jitter does not enter).
-  out_.filtered = options_.filter;
-  out_.published =
-      options_.filter ? filter_.update(out_.measured, frame.timestamp_ns) : out_.measured;
+  out_.filtered = filter;
+  out_.published = filter ? filter_.update(out_.measured, frame.timestamp_ns) : out_.measured;
   if (!out_.published.valid) {
     out_.published.refusal = out_.measured.valid ? Refusal::kFilterRejected : out_.measured.refusal;
   }
   out_.refusal = out_.measured.valid ? out_.published.refusal : out_.measured.refusal;
-  out_.motion.valid = options_.filter && out_.published.valid && filter_.initialised();
-  if (out_.motion.valid) {
-    out_.motion.time_ns = filter_.state_time_ns();
-    out_.motion.state = filter_.state();
-    out_.motion.jerk = filter_.jerk_density();
-    out_.motion.horizon_ms = pipeline_.config().filter.predict_horizon_ms;
-  }
+  out_.motion = filter && out_.published.valid ? filter_.motion() : MotionEstimate{};
 
   // 3. Fix state.
   if (out_.measured.valid && out_.published.valid) {
@@ -68,11 +65,9 @@ const Localization& Localizer::localize(const ImageView& image, const FrameInfo&
 CameraMotion Localizer::readout_motion(int64_t t_ns) const {
   CameraMotion m;
   const PipelineConfig& c = pipeline_.config();
-  if (!options_.filter || !filter_.initialised() || !(c.intrinsics.readout_ms > 0.0)) return m;
-  const MotionEstimate e{true, filter_.state_time_ns(), filter_.state(), filter_.jerk_density(),
-                         c.filter.predict_horizon_ms};
-  if (!(std::abs(static_cast<double>(t_ns - e.time_ns)) * 1e-6 <= e.horizon_ms)) return m;
-  const MotionState s = motion_at(e, t_ns);
+  if (!c.filter.enabled || !(c.intrinsics.readout_ms > 0.0)) return m;
+  MotionState s;
+  if (predict_motion(filter_.motion(), t_ns, &s) != PredictOutcome::kOk) return m;
   constexpr int N = kMotionStates;
   const double yaw = s.x[2], vx = s.x[3], vy = s.x[4], w = s.x[5];
   // The optical centre sits at R(yaw)·offset from the robot: it moves by

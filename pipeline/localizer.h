@@ -16,16 +16,15 @@
 
 namespace ceilpose {
 
-struct LocalizerOptions {
-  PositioningMode mode = PositioningMode::kAuto;
-  // Apply the temporal filter (the daemon's default; `locate` with --filter).
-  bool filter = true;
-};
+// `config` with the positioning mode and the filter switch set, as `locate
+// --mode --filter` and the tests choose them.
+PipelineConfig with_mode(PipelineConfig config, PositioningMode mode, bool filter);
 
 class Localizer {
  public:
   // Throws std::invalid_argument (from Pipeline) on a non-positive image size.
-  Localizer(const PipelineConfig& config, LocalizerOptions options);
+  // The mode is config.positioning.mode, the filter on when config.filter.enabled.
+  explicit Localizer(const PipelineConfig& config);
 
   // Localizes one frame taken at frame.timestamp_ns (monotonic order). The
   // result stays valid until the next call.
@@ -33,10 +32,9 @@ class Localizer {
 
   // Between frames (SIGHUP): new tuning, mode and filter switch; the filter's
   // state is kept unless `reset_filter`.
-  void reconfigure(const PipelineConfig& config, LocalizerOptions options, bool reset_filter);
+  void reconfigure(const PipelineConfig& config, bool reset_filter);
 
   const PipelineConfig& config() const { return pipeline_.config(); }
-  const LocalizerOptions& options() const { return options_; }
   const RefusalHistogram& refusals() const { return refusals_; }
   const FilterStats& filter_stats() const { return filter_.stats(); }
   // The last frame's detection in detail (markers, rejects), for diagnostics.
@@ -45,7 +43,6 @@ class Localizer {
 
  private:
   Pipeline pipeline_;
-  LocalizerOptions options_;
   TemporalFilter filter_;
   std::unique_ptr<FrameResult> result_;  // ~50 kB: on the heap, allocated once
   Localization out_;

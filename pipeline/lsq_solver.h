@@ -3,29 +3,50 @@
 // yaw, roll/pitch tilt, optionally height) from every point of every
 // consistent marker, by Levenberg–Marquardt on the reprojection error with
 // Huber weights, marker-level outlier rejection, and a covariance of the
-// robot's (x, y, yaw) from the residuals, the map's sigmas and the scatter
-// of the markers about their mapped places.
+// robot's (x, y, yaw) (lsq_covariance.h). The solve reads as named steps
+// (lsq_solver.cpp): gather the points, choose the tilt model, accept,
+// covariance. Its terms (residuals, Jacobians, priors) are lsq_terms.h's.
 #include <array>
+#include <cmath>
+#include <cstdint>
 #include <span>
 
 #include "core/pose.h"
 #include "pipeline/change_of_axes.h"
+#include "pipeline/lsq_covariance.h"
+#include "pipeline/lsq_terms.h"
 #include "pipeline/marker_observation.h"
 #include "pipeline/positioning_params.h"
 
 namespace ceilpose {
+
+// How the tilt model was chosen, and on what evidence.
+enum class TiltChoice : uint8_t {
+  kNotAllowed,  // estimation off, or fewer than lsq_tilt_min_markers markers
+  kHeldFits,    // the free fit neither fits significantly better nor moves the pose
+  kFreeFailed,  // the free fit diverged, lost markers, or found a tilt no mount has
+  kFreeFits,    // estimated: significantly better, and it moves the pose
+};
+const char* to_string(TiltChoice choice);
 
 struct LsqResult {
   Pose2D robot;
   std::array<double, 9> covariance{};  // (x_m, y_m, yaw_rad), row-major
   double rms_px = 0.0;                 // inliers' RMS reprojection residual
   int markers = 0;                     // markers kept after rejection
+  int rejected = 0;                    // markers rejected for their residual
   int points = 0;
   int iterations = 0;
   double tilt_x_rad = 0.0;  // estimated camera tilt (core's tilt convention)
   double tilt_y_rad = 0.0;
   double lens_height_m = 0.0;
   bool tilt_estimated = false;  // false: held at the mount's nominal tilt
+  TiltChoice tilt_choice = TiltChoice::kNotAllowed;
+  // The tilt decision's evidence: how far the free-tilt pose is from the
+  // held-tilt one, metres, and by how much freeing the tilt lowered the
+  // cost, in units of the free fit's noise (chi-square).
+  double tilt_shift_m = 0.0;
+  double tilt_chi2 = 0.0;
   // Rolling shutter (camera.readout_ms > 0): the optical centre's velocity
   // and the yaw rate during the readout, world frame, when the markers span
   // enough rows to tell them (motion_estimated); the pose is the centre row's.
@@ -53,79 +74,35 @@ class LsqSolver {
              std::span<bool> use, const CameraMotion& motion, LsqResult* out);
 
  private:
-  struct Point {
-    double x_n, y_n;  // undistorted normalized observation (camera frame)
-    Vec3 world;       // marker point on the ceiling
-    int fix;          // index into fixes
-    double tau_s;     // when its row was exposed, after the centre row (rolling shutter)
+  // One fit of one model: its markers, state and cost.
+  struct Fit {
+    LsqModel model;
+    LsqState state;
+    std::array<bool, kMaxMarkersPerFrame> use{};
+    int markers = 0;
+    double cost = INFINITY;  // not finite: no solution
   };
-  struct State {
-    Vec3 t_w;                            // optical centre at the centre row's time
-    Mat3 r_wc;                           // camera axes in the world, then
-    double vx = 0.0, vy = 0.0, w = 0.0;  // optical centre velocity, yaw rate
-  };
-  // tx, ty, yaw, tilt about Xc, tilt about Yc, tz, and the motion during the
-  // readout: vx, vy, yaw rate.
-  static constexpr int kParams = 9;
-  // The camera when point pt's row was exposed.
-  static void camera_at(const State& st, const Point& pt, Vec3* t_w, Mat3* r_wc);
-  // What a point's residual and Jacobian need of that camera: Rᵀ, the
-  // increment axes (with_axes) and d = P − t. `centre` holds Rᵀ and the axes
-  // at the centre row, which a global shutter's points reuse.
-  struct PointCamera {
-    Vec3 d;
-    Mat3 rt;
-    std::array<Vec3, 3> axis;
-  };
-  static PointCamera point_camera(const State& st, const Point& pt, const PointCamera& centre,
-                                  bool with_axes);
-  using Normal = std::array<double, kParams * kParams>;
-  using Vector = std::array<double, kParams>;
 
-  // Weighted normal equations at `state`; returns the robust cost.
-  double accumulate(const ViewGeometry& view, const PositioningParams& params,
-                    std::span<const bool> use, const State& state, bool with_jacobian, Normal* a,
-                    Vector* b, double* sum_w_r2, int* count) const;
-  // Squared reprojection residual of one point, pixels².
-  static double residual2_px(const ViewGeometry& view, const State& st, const Point& pt);
-  double optimise(const ViewGeometry& view, const PositioningParams& params, std::span<bool> use,
-                  std::span<const MarkerFix> fixes, bool reject, State* state, int* marker_count,
-                  int* iterations);
-  double prior_cost(const ViewGeometry& view, const PositioningParams& params, const State& state,
-                    Normal* a, Vector* b) const;
-  // `st` with the motion it is held at when not estimated.
-  State held_motion(const State& st) const;
-  // Whether the points span enough rows (and markers) to estimate the motion.
-  bool motion_observable(const ViewGeometry& view, std::span<const bool> use,
-                         int marker_count) const;
   // The steps of solve(), in order (see lsq_solver.cpp).
   int gather_points(const ViewGeometry& view, std::span<const MarkerObservation> markers,
-                    std::span<const MarkerFix> fixes, std::span<const bool> use, State* seed);
-  double fit(const ViewGeometry& view, const PositioningParams& params,
-             std::span<const MarkerFix> fixes, std::span<bool> use, State* st, int* marker_count,
-             int* iterations, bool* tilt_estimated);
-  double rms_px(const ViewGeometry& view, std::span<const bool> use, const State& st, int n) const;
-  Normal placement_information(const ViewGeometry& view, const PositioningParams& params,
-                               std::span<const MarkerFix> fixes, std::span<const bool> consistent,
-                               std::span<const bool> use, const State& st);
-  bool robot_covariance(const ViewGeometry& view, const PositioningParams& params, const Normal& a,
-                        const Normal& placement, double wr2, int n, const Pose2D& robot,
-                        std::array<double, 9>* out) const;
+                    std::span<const MarkerFix> fixes, std::span<const bool> use,
+                    const LsqModel& model, LsqState* seed);
+  Fit choose_tilt_model(const ViewGeometry& view, const PositioningParams& params,
+                        std::span<const MarkerFix> fixes, const Fit& seed, int* iterations,
+                        LsqResult* out);
+  void optimise(const ViewGeometry& view, const PositioningParams& params,
+                std::span<const MarkerFix> fixes, Fit* fit, int* iterations) const;
+  int worst_marker(const ViewGeometry& view, const PositioningParams& params,
+                   std::span<const MarkerFix> fixes, const Fit& fit) const;
+  bool motion_observable(const ViewGeometry& view, const PositioningParams& params,
+                         std::span<const bool> use, int marker_count) const;
+  double rms_px(const ViewGeometry& view, std::span<const bool> use, const LsqState& st,
+                int n) const;
+  std::span<const LsqPoint> points() const { return {points_.data(), size_t(point_count_)}; }
 
-  // Per marker: B_k (kParams x 3, row-major), and J_m^T J_m, J_m^T r of its
-  // own placement parameters (centre x, y, rotation).
-  struct MarkerTerm {
-    std::array<double, kParams * 3> b{};
-    std::array<double, 9> jtj{};
-    std::array<double, 3> jtr{};
-    int points = 0;
-  };
-
-  std::array<Point, kMaxMarkersPerFrame * kMaxPointsPerMarker> points_{};
+  std::array<LsqPoint, kMaxMarkersPerFrame * kMaxPointsPerMarker> points_{};
   int point_count_ = 0;
-  std::array<bool, kParams> active_{};
-  std::array<MarkerTerm, kMaxMarkersPerFrame> marker_terms_{};
-  CameraMotion motion_;  // this solve's
+  LsqCovariance covariance_;
 };
 
 }  // namespace ceilpose

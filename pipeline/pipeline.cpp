@@ -127,8 +127,10 @@ PairOutcome Pipeline::decode(const ImageView& frame, const MarkerPair& pair,
   }
   o.whole = whole;
   const float margin = std::min(code_i.margin, code_j.margin);
-  o.quality = std::clamp(margin / 0.3f, 0.0f, 1.0f) *
-              std::clamp(1.0f - static_cast<float>(pair.score) / 4.0f, 0.0f, 1.0f);
+  o.quality =
+      std::clamp(margin / config_.detector.quality_full_margin, 0.0f, 1.0f) *
+      std::clamp(1.0f - static_cast<float>(pair.score) / config_.detector.quality_zero_pair_score,
+                 0.0f, 1.0f);
   // Points for positioning: the centroids. Area centroids of the full
   // rectangles (dots folded in) are unbiased under the affine view of a level
   // camera, thresholding shifts opposite edges alike, and fit_rectangles has

@@ -4,9 +4,14 @@
 // Every field: meaning, unit, effect, when to tune.
 #include <cmath>
 
+#include "core/positioning_mode.h"
+
 namespace ceilpose {
 
 struct PositioningParams {
+  // The positioning mode (positioning.mode; `locate --mode`): auto picks the
+  // best the view allows (lsq, else barycentric, else Change of Axes).
+  PositioningMode mode = PositioningMode::kAuto;
   // --- least squares (camera attitude from all marker points) ---
   // Levenberg–Marquardt iterations per solve. Each costs one pass over the
   // points (~1 µs per 100 points). Converges in 3–6 from the thesis-mode
@@ -58,6 +63,27 @@ struct PositioningParams {
   // Also solve the lens-to-ceiling distance (usually known from config).
   // Only for ceilings of uncertain height; it weakens the position solution.
   bool lsq_estimate_height = false;
+  // Marker-level rejection passes after the first solve: each drops the
+  // worst marker above lsq_marker_reject_px. More passes survive more wrong
+  // markers in one view, at one solve each.
+  int lsq_max_rejections = 3;
+  // Rolling shutter: the camera's motion during the readout is estimated only
+  // from markers spread over at least this share of the readout's rows...
+  double lsq_motion_min_row_span = 0.3;
+  // ... and at least this many markers; otherwise it is held (at the filter's
+  // motion when known, else at rest). Lower both to estimate motion from
+  // fewer markers at the cost of a noisier pose.
+  int lsq_motion_min_markers = 3;
+  // Prior of the motion when the filter gives none: rest, with these
+  // standard deviations per pixel of residual, m/s and rad/s. It only
+  // conditions a solve whose rows barely tell the motion.
+  double lsq_motion_prior_mps = 1.0;
+  double lsq_motion_prior_radps = 3.0;
+  // Floors on the filter's motion sigmas when they are the prior, m/s and
+  // rad/s: a filter that has just missed a turn must not override what the
+  // rows say. Raise them if turns in the view come out too smooth.
+  double lsq_motion_prior_floor_mps = 0.05;
+  double lsq_motion_prior_floor_radps = 0.2;
 
   // --- grid consistency (rejecting markers whose code disagrees) ---
   // Two markers agree when the camera positions they imply differ by less

@@ -34,6 +34,24 @@ JerkDensity TemporalFilter::jerk_density() const {
   return {j * j, j * j, yj * yj};
 }
 
+MotionEstimate TemporalFilter::motion() const {
+  if (!initialised_) return {};
+  return MotionEstimate{true, last_ns_, state_, jerk_density(), params_.predict_horizon_ms};
+}
+
+// The measurement's covariance with the configured floors: a solver's
+// sigma of micrometres must not make the filter trust it beyond what the
+// pose is really worth.
+std::array<double, 9> TemporalFilter::floored_covariance(const PoseEstimate& m) const {
+  std::array<double, 9> r = m.covariance;
+  const double floor_m2 = params_.meas_sigma_floor_m * params_.meas_sigma_floor_m;
+  const double floor_rad2 = params_.meas_sigma_floor_yaw_rad * params_.meas_sigma_floor_yaw_rad;
+  r[0] = std::max(r[0], floor_m2);
+  r[4] = std::max(r[4], floor_m2);
+  r[8] = std::max(r[8], floor_rad2);
+  return r;
+}
+
 void TemporalFilter::initialise(const PoseEstimate& m, int64_t timestamp_ns) {
   state_.x.fill(0.0);
   state_.x[0] = m.pose.x_m;
@@ -41,13 +59,9 @@ void TemporalFilter::initialise(const PoseEstimate& m, int64_t timestamp_ns) {
   state_.x[2] = m.pose.yaw_rad;
   std::array<double, kN* kN>& p = state_.p;
   p.fill(0.0);
-  for (int r = 0; r < 3; ++r)
-    for (int c = 0; c < 3; ++c) p[r * kN + c] = m.covariance[r * 3 + c];
-  const double floor_m2 = params_.meas_sigma_floor_m * params_.meas_sigma_floor_m;
-  const double floor_rad2 = params_.meas_sigma_floor_yaw_rad * params_.meas_sigma_floor_yaw_rad;
-  p[0 * kN + 0] = std::max(p[0 * kN + 0], floor_m2);
-  p[1 * kN + 1] = std::max(p[1 * kN + 1], floor_m2);
-  p[2 * kN + 2] = std::max(p[2 * kN + 2], floor_rad2);
+  const std::array<double, 9> r = floored_covariance(m);
+  for (int row = 0; row < 3; ++row)
+    for (int c = 0; c < 3; ++c) p[row * kN + c] = r[row * 3 + c];
   const double sigma[kN] = {0.0,
                             0.0,
                             0.0,
@@ -95,12 +109,7 @@ bool TemporalFilter::innovation(const PoseEstimate& m, std::array<double, 3>* y,
                                 std::array<double, 9>* s_inv) const {
   *y = {m.pose.x_m - state_.x[0], m.pose.y_m - state_.x[1],
         wrap_angle_rad(m.pose.yaw_rad - state_.x[2])};
-  std::array<double, 9> r = m.covariance;
-  const double floor_m2 = params_.meas_sigma_floor_m * params_.meas_sigma_floor_m;
-  const double floor_rad2 = params_.meas_sigma_floor_yaw_rad * params_.meas_sigma_floor_yaw_rad;
-  r[0] = std::max(r[0], floor_m2);
-  r[4] = std::max(r[4], floor_m2);
-  r[8] = std::max(r[8], floor_rad2);
+  const std::array<double, 9> r = floored_covariance(m);
   std::array<double, 9> s{};
   for (int i = 0; i < 3; ++i)
     for (int j = 0; j < 3; ++j) s[i * 3 + j] = state_.p[i * kN + j] + r[i * 3 + j];

@@ -42,9 +42,13 @@ class TemporalFilter {
   const MotionState& state() const { return state_; }
   int64_t state_time_ns() const { return last_ns_; }
   JerkDensity jerk_density() const;
+  // The state as consumers carry it to another instant (within
+  // predict_horizon_ms); not valid before initialisation.
+  MotionEstimate motion() const;
 
  private:
   static constexpr int kN = kMotionStates;
+  std::array<double, 9> floored_covariance(const PoseEstimate& m) const;
   void initialise(const PoseEstimate& measurement, int64_t timestamp_ns);
   void predict(double dt_s);
   bool innovation(const PoseEstimate& m, std::array<double, 3>* y,

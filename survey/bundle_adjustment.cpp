@@ -33,17 +33,15 @@ struct Reprojection {
     const T e = size[0] * e_m, n = size[0] * n_m;
     const T dx = marker[0] + cm * e - sm * n - camera[0];
     const T dy = marker[1] + sm * e + cm * n - camera[1];
-    // The level camera's axes (SPEC §3): Xc = (−s, c, 0), Yc = (−c, −s, 0).
-    const T c = cos(camera[2]), s = sin(camera[2]);
-    const T lx = -s * dx + c * dy, ly = -c * dx - s * dy, lz = T(depth_m);
-    // R_wc = Level·Rx(a)·Ry(b) (core/camera_model): camera = Ry(b)ᵀ·Rx(a)ᵀ·level.
-    const T a = T(tilt_x0_rad) + tilt[0], b = T(tilt_y0_rad) + tilt[1];
-    const T ca = cos(a), sa = sin(a), cb = cos(b), sb = sin(b);
-    const T q1 = ca * ly + sa * lz, q2 = -sa * ly + ca * lz;
-    const T px = cb * lx - sb * q2, pz = sb * lx + cb * q2;
+    // The level camera (SPEC §3), then the tilt (core/camera_model.h).
+    T lx, ly;
+    world_to_level(T(cos(camera[2])), T(sin(camera[2])), dx, dy, &lx, &ly);
+    T px, py, pz;
+    level_to_tilted(T(tilt_x0_rad) + tilt[0], T(tilt_y0_rad) + tilt[1], lx, ly, T(depth_m), &px,
+                    &py, &pz);
     if (pz <= T(1e-6)) return false;
     T xd, yd;
-    plumb_bob(k + 4, px / pz, q1 / pz, &xd, &yd);
+    plumb_bob(k + 4, px / pz, py / pz, &xd, &yd);
     r[0] = k[0] * xd + k[2] - u_px;
     r[1] = k[1] * yd + k[3] - v_px;
     return true;
@@ -115,16 +113,15 @@ void sort_sightings(const PipelineConfig& config, const std::vector<SurveyFrame>
     const SurveyFrame& frame = frames[static_cast<size_t>(f)];
     const CameraPose cam = camera_pose_from_robot(frame.robot, config.mount);
     const double yaw = frame.robot.yaw_rad + config.mount.yaw_rad;
-    const double c = std::cos(yaw), s = std::sin(yaw);
     for (int k = 0; k < static_cast<int>(frame.markers.size()); ++k) {
       const MarkerObservation& m = frame.markers[static_cast<size_t>(k)];
       if (!m.whole || m.code_i < 0 || m.code_j < 0 || m.code_i >= codes || m.code_j >= codes)
         continue;
       double xn = 0.0, yn = 0.0;
       view.level_normalized(m.centre_u_px, m.centre_v_px, &xn, &yn);
-      const double d = view.depth_m();
-      const double x = cam.t_w[0] - s * d * xn - c * d * yn;
-      const double y = cam.t_w[1] + c * d * xn - s * d * yn;
+      double dx = 0.0, dy = 0.0;
+      view.ceiling_offset(yaw, xn, yn, &dx, &dy);
+      const double x = cam.t_w[0] + dx, y = cam.t_w[1] + dy;
       if (std::hypot(x - m.code_i * layout.grid_m, y - m.code_j * layout.grid_m) <=
           options.duplicate_distance_m) {
         home->push_back({f, k, m.code_j * codes + m.code_i});

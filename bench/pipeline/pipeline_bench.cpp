@@ -98,7 +98,7 @@ void BM_Pipeline(benchmark::State& state) {
   // The daemon's per-frame object, filter off: figures stay per frame.
   PipelineConfig config = config_for(width_px);
   config.intrinsics.readout_ms = readout_ms;
-  Localizer localizer(config, LocalizerOptions{PositioningMode::kAuto, false});
+  Localizer localizer(with_mode(config, PositioningMode::kAuto, false));
   FrameInfo info;
   // Medians, not means: on a shared machine a preempted iteration would
   // otherwise dominate the figure.

@@ -60,25 +60,22 @@ MotionEstimate pose_motion(const PoseRecord& p) {
 
 PredictResult predict_pose(const PoseRecord& pose, int64_t t_mono_ns, PoseRecord* out) {
   *out = pose;
-  if ((pose.flags & kPoseMotion) == 0 || !pose_is_valid(pose)) return PredictResult::kNoMotion;
-  // In double: an int64 difference of arbitrary instants cannot overflow it.
-  const double dt_s =
-      (static_cast<double>(t_mono_ns) - static_cast<double>(pose.capture_mono_ns)) * 1e-9;
-  if (!(std::abs(dt_s) * 1e3 <= static_cast<double>(pose.predict_horizon_ms)))
-    return PredictResult::kBeyondHorizon;
-  const double x[kMotionStates] = {pose.x_m,     pose.y_m,     pose.yaw_rad,
-                                   pose.vx_mps,  pose.vy_mps,  pose.yaw_rate_radps,
-                                   pose.ax_mps2, pose.ay_mps2, pose.yaw_accel_radps2};
-  double ahead[kMotionStates];
-  const JerkDensity jerk{pose.jerk_density[0], pose.jerk_density[1], pose.jerk_density[2]};
-  // Pose and rates (orders 0 and 1); the accelerations stay as they were.
-  propagate_motion(x, pose.state_covariance, dt_s, jerk, ahead, out->state_covariance, 2);
-  out->x_m = ahead[0];
-  out->y_m = ahead[1];
-  out->yaw_rad = wrap_angle_rad(ahead[2]);
-  out->vx_mps = ahead[3];
-  out->vy_mps = ahead[4];
-  out->yaw_rate_radps = ahead[5];
+  MotionState ahead;
+  switch (predict_motion(pose_motion(pose), t_mono_ns, &ahead)) {
+    case PredictOutcome::kNoMotion:
+      return PredictResult::kNoMotion;
+    case PredictOutcome::kBeyondHorizon:
+      return PredictResult::kBeyondHorizon;
+    case PredictOutcome::kOk:
+      break;
+  }
+  out->x_m = ahead.x[0];
+  out->y_m = ahead.x[1];
+  out->yaw_rad = ahead.x[2];
+  out->vx_mps = ahead.x[3];
+  out->vy_mps = ahead.x[4];
+  out->yaw_rate_radps = ahead.x[5];
+  std::copy(ahead.p.begin(), ahead.p.end(), out->state_covariance);
   for (int r = 0; r < 3; ++r)
     for (int c = 0; c < 3; ++c)
       out->covariance[r * 3 + c] = out->state_covariance[r * kMotionStates + c];

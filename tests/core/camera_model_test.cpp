@@ -71,6 +71,46 @@ TEST(CameraModel, ProjectionMatchesOpenCvWithDistortion) {
   }
 }
 
+// The one geometry: the level transforms are each other's inverse and agree
+// with the camera pose's axes; yaw and tilt are read back from the rotation.
+TEST(CameraGeometry, LevelTransformsAgreeWithTheCameraPose) {
+  const Pose2D robot{1.0, -2.0, 0.7};
+  const CameraMount mount;
+  const CameraPose cam = camera_pose_from_robot(robot, mount);
+  const double c = std::cos(robot.yaw_rad), s = std::sin(robot.yaw_rad);
+  const double dx = 0.31, dy = -0.12;
+  double x = 0, y = 0, bx = 0, by = 0;
+  world_to_level(c, s, dx, dy, &x, &y);
+  // Camera coordinates are Rᵀ·d.
+  const Vec3 p = mat_vec(mat_transpose(cam.r_wc), {dx, dy, 0.0});
+  EXPECT_NEAR(x, p[0], 1e-12);
+  EXPECT_NEAR(y, p[1], 1e-12);
+  level_to_world(c, s, x, y, &bx, &by);
+  EXPECT_NEAR(bx, dx, 1e-12);
+  EXPECT_NEAR(by, dy, 1e-12);
+}
+
+TEST(CameraGeometry, YawAndTiltAreReadBackFromTheRotation) {
+  for (double yaw : {-3.0, -0.4, 0.0, 1.2, 3.1})
+    for (double a : {-0.05, 0.0, 0.02})
+      for (double b : {-0.03, 0.0, 0.04}) {
+        const Mat3 r = mat_mul(level_rotation(yaw), tilt_rotation(a, b));
+        double ra = 0, rb = 0;
+        camera_tilt_of(r, &ra, &rb);
+        EXPECT_NEAR(camera_yaw_of(r), yaw, 1e-12);
+        EXPECT_NEAR(ra, a, 1e-12);
+        EXPECT_NEAR(rb, b, 1e-12);
+        // level_to_tilted is the tilt's transpose.
+        const Vec3 l{0.2, -0.1, 2.1};
+        const Vec3 t = mat_vec(mat_transpose(tilt_rotation(a, b)), l);
+        double px = 0, py = 0, pz = 0;
+        level_to_tilted(a, b, l[0], l[1], l[2], &px, &py, &pz);
+        EXPECT_NEAR(px, t[0], 1e-12);
+        EXPECT_NEAR(py, t[1], 1e-12);
+        EXPECT_NEAR(pz, t[2], 1e-12);
+      }
+}
+
 TEST(CeilingLayout, SlotsAreReadNorthToSouthMsbFirst) {
   const CeilingLayout layout;
   EXPECT_NEAR(layout.slot_n_m(0), 4 * kInch_m, 1e-12);

@@ -47,7 +47,7 @@ AccuracyReport run_scenario(const std::string& name, int frames, uint64_t seed,
   AccuracySink accuracy(config.layout.grid_m, [&](const Pose2D& truth) {
     return sim::count_whole_markers(options, truth, current->mount) > 0;
   });
-  Localizer localizer(config, LocalizerOptions{mode, filter});
+  Localizer localizer(with_mode(config, mode, filter));
   Image image;
   for (const sim::ScenarioFrame& f : scenario->frames) {
     sim::render_scenario_frame(renderer, f, f.mount, rendered_readout_ms * 1e-3, &image);

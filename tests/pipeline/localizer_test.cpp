@@ -34,7 +34,7 @@ class LocalizerTest : public ::testing::Test {
 };
 
 TEST_F(LocalizerTest, UnfilteredPublishesTheMeasurementAndNamesEachRefusal) {
-  Localizer localizer(config_, LocalizerOptions{PositioningMode::kAuto, false});
+  Localizer localizer(with_mode(config_, PositioningMode::kAuto, false));
   const Pose2D robot{2.0, 2.0, 0.4};
   const Image ceiling = frame_at(robot);
 
@@ -68,7 +68,7 @@ TEST_F(LocalizerTest, UnfilteredPublishesTheMeasurementAndNamesEachRefusal) {
 
 TEST_F(LocalizerTest, FilteredCoastsThroughAMissingFrameThenLosesTheFix) {
   config_.filter.predict_timeout_ms = 100.0;  // three frames
-  Localizer localizer(config_, LocalizerOptions{PositioningMode::kAuto, true});
+  Localizer localizer(with_mode(config_, PositioningMode::kAuto, true));
   const Localization& none = localizer.localize(black_.view(), next_frame());
   EXPECT_EQ(none.fix, FixState::kNone) << "no fix since start";
   EXPECT_EQ(none.published.refusal, Refusal::kNoMarkers);
@@ -98,7 +98,7 @@ TEST_F(LocalizerTest, WrongHeightsAreRefusedWhereThePositionerDecides) {
   // the frame: the markers' spacing says so.
   PipelineConfig wrong = config_;
   wrong.mount.lens_height_m = config_.mount.lens_height_m - 0.4;
-  Localizer localizer(wrong, LocalizerOptions{PositioningMode::kAuto, false});
+  Localizer localizer(with_mode(wrong, PositioningMode::kAuto, false));
   const Localization& loc = localizer.localize(frame_at({2.0, 2.0, 0.0}).view(), next_frame());
   EXPECT_FALSE(loc.published.valid);
   EXPECT_EQ(loc.refusal, Refusal::kWrongHeights);
@@ -106,11 +106,11 @@ TEST_F(LocalizerTest, WrongHeightsAreRefusedWhereThePositionerDecides) {
 }
 
 TEST_F(LocalizerTest, ReconfigureSwitchesModeAndFilterBetweenFrames) {
-  Localizer localizer(config_, LocalizerOptions{PositioningMode::kAuto, true});
+  Localizer localizer(with_mode(config_, PositioningMode::kAuto, true));
   const Image ceiling = frame_at({2.0, 2.0, 0.4});
   EXPECT_EQ(localizer.localize(ceiling.view(), next_frame()).published.mode,
             PositioningMode::kLeastSquares);
-  localizer.reconfigure(config_, LocalizerOptions{PositioningMode::kChangeOfAxes, false}, true);
+  localizer.reconfigure(with_mode(config_, PositioningMode::kChangeOfAxes, false), true);
   const Localization& axes = localizer.localize(ceiling.view(), next_frame());
   EXPECT_FALSE(axes.filtered);
   EXPECT_EQ(axes.published.mode, PositioningMode::kChangeOfAxes);

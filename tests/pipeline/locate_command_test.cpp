@@ -20,13 +20,8 @@ namespace {
 
 namespace fs = std::filesystem;
 
-// The binary sits at <build>/ctl/ceilposectl, this test at
-// <build>/tests/pipeline/pipeline_tests; CEILPOSECTL overrides.
-fs::path ctl_binary() {
-  if (const char* env = std::getenv("CEILPOSECTL")) return env;
-  return fs::read_symlink("/proc/self/exe").parent_path().parent_path().parent_path() / "ctl" /
-         "ceilposectl";
-}
+// Built before this test (tests/pipeline/CMakeLists.txt depends on it).
+fs::path ctl_binary() { return CEILPOSECTL_PATH; }
 
 struct CommandRun {
   int exit_code = -1;
@@ -37,7 +32,6 @@ struct CommandRun {
 class LocateCommand : public ::testing::Test {
  protected:
   void SetUp() override {
-    if (!fs::exists(ctl_binary())) GTEST_SKIP() << ctl_binary() << " not built";
     char tmpl[] = "/tmp/ceilpose_locate_XXXXXX";
     ASSERT_NE(::mkdtemp(tmpl), nullptr);
     dir_ = tmpl;
@@ -179,6 +173,21 @@ TEST_F(LocateCommand, FilterGivesVelocityAndPredictMsThePoseAhead) {
   EXPECT_NEAR(field(out.back(), "x_m") - x_now, 0.06, 0.002) << out.back();
   EXPECT_NEAR(field(out.back(), "vx_mps"), 0.6, 0.01) << out.back();
   EXPECT_EQ(run("locate --predict-ms nope --replay " + rec.string()).exit_code, 2);
+}
+
+// The horizon every client honours (filter.predict_horizon_ms, 200 ms by
+// default): a prediction beyond it, or NaN, is a usage error naming it.
+TEST_F(LocateCommand, PredictionBeyondTheFiltersHorizonIsAUsageError) {
+  const fs::path rec = record({{1.2, 1.5, 0.3}, {1.22, 1.5, 0.3}});
+  for (const char* ms : {"250", "-201", "nan"}) {
+    const CommandRun r =
+        run(std::string("locate --predict-ms ") + ms + " --replay " + rec.string());
+    EXPECT_EQ(r.exit_code, 2) << ms << ": " << r.err;
+    EXPECT_NE(r.err.find("beyond the filter's horizon of 200 ms (filter.predict_horizon_ms"),
+              std::string::npos)
+        << r.err;
+    EXPECT_EQ(r.out, "") << ms;
+  }
 }
 
 TEST_F(LocateCommand, MalformedRecordingExitsFourNamingFileAndLine) {

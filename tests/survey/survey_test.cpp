@@ -37,7 +37,7 @@ Walk run(const std::string& scenario, int count, uint64_t seed,
   auto set = sim::make_scenario(scenario, scene, count, seed);
   EXPECT_TRUE(set) << set.error().message;
   sim::Renderer renderer(scene);
-  Localizer localizer(config, LocalizerOptions{PositioningMode::kLeastSquares, false});
+  Localizer localizer(with_mode(config, PositioningMode::kLeastSquares, false));
   AccuracyAccumulator accuracy(config.layout.grid_m);
   Walk out;
   Image image;

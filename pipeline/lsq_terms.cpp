@@ -1,0 +1,228 @@
+#include "pipeline/lsq_terms.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include "core/small_matrix.h"
+
+namespace ceilpose {
+namespace {
+
+constexpr int kN = kLsqParams;
+
+// Rotation by angle a about the world's vertical, applied on the left.
+Mat3 turned(const Mat3& r, double a) {
+  const double s = std::sin(a), c = std::cos(a);
+  return mat_mul({c, -s, 0.0, s, c, 0.0, 0.0, 0.0, 1.0}, r);
+}
+
+// The camera when a point tau_s after the centre row was exposed: t + v·tau
+// and Exp(w·tau·z)·R.
+void camera_at(const LsqState& st, double tau_s, Vec3* t_w, Mat3* r_wc) {
+  if (tau_s == 0.0) {  // global shutter: no arithmetic, the same bits
+    *t_w = st.t_w;
+    *r_wc = st.r_wc;
+    return;
+  }
+  *t_w = {st.t_w[0] + st.vx * tau_s, st.t_w[1] + st.vy * tau_s, st.t_w[2]};
+  *r_wc = turned(st.r_wc, st.w * tau_s);
+}
+
+}  // namespace
+
+int LsqModel::free_count() const {
+  int n = 0;
+  for (bool a : active) n += a ? 1 : 0;
+  return n;
+}
+
+PointCamera centre_camera(const LsqState& st) {
+  const Mat3 lev = level_rotation(camera_yaw_of(st.r_wc));
+  return {{},
+          mat_transpose(st.r_wc),
+          {{{0.0, 0.0, 1.0}, {lev[0], lev[3], lev[6]}, {lev[1], lev[4], lev[7]}}}};
+}
+
+PointCamera point_camera(const LsqState& st, const LsqPoint& pt, const PointCamera& centre,
+                         bool with_axes) {
+  PointCamera cam = centre;
+  Vec3 t_w = st.t_w;
+  if (pt.tau_s != 0.0) {
+    Mat3 r_wc;
+    camera_at(st, pt.tau_s, &t_w, &r_wc);
+    cam.rt = mat_transpose(r_wc);
+    if (with_axes) {
+      // The turn about the vertical turns the level axes with it; the yaw
+      // axis stays vertical.
+      const double a = st.w * pt.tau_s, sa = std::sin(a), ca = std::cos(a);
+      for (int k = 1; k < 3; ++k) {
+        const Vec3 l = centre.axis[k];
+        cam.axis[k] = {ca * l[0] - sa * l[1], sa * l[0] + ca * l[1], l[2]};
+      }
+    }
+  }
+  cam.d = {pt.world[0] - t_w[0], pt.world[1] - t_w[1], pt.world[2] - t_w[2]};
+  return cam;
+}
+
+bool point_residual(const ViewGeometry& view, const LsqPoint& pt, const PointCamera& cam,
+                    double* rx, double* ry) {
+  const Vec3 p = mat_vec(cam.rt, cam.d);
+  if (p[2] < 1e-3) return false;
+  *rx = normalized_residual_px(view.intrinsics().fx, pt.x_n, p[0], p[2]);
+  *ry = normalized_residual_px(view.intrinsics().fy, pt.y_n, p[1], p[2]);
+  return true;
+}
+
+// For a ceiling point P, d = P − t and p = Rᵀd: ∂p/∂t = −Rᵀ, ∂p/∂ω = Rᵀ[d]×,
+// and x = X/Z, y = Y/Z give ∂x/∂p = (1/Z, 0, −X/Z²), ∂y/∂p = (0, 1/Z, −Y/Z²).
+// A point exposed tau after the centre row has its camera at t + v·tau and
+// Exp(w·tau·z)·R, so v and w move it as t and the yaw do, tau times as much.
+void point_jacobian(const ViewGeometry& view, const LsqPoint& pt, const PointCamera& cam,
+                    double* jx, double* jy) {
+  const double fx = view.intrinsics().fx, fy = view.intrinsics().fy;
+  const Vec3& d = cam.d;
+  const Vec3 p = mat_vec(cam.rt, d);
+  const double iz = 1.0 / p[2];
+  double dp[3][kN] = {};
+  for (int row = 0; row < 3; ++row) {
+    dp[row][kLsqTx] = -cam.rt[row * 3 + 0];
+    dp[row][kLsqTy] = -cam.rt[row * 3 + 1];
+    dp[row][kLsqTz] = -cam.rt[row * 3 + 2];
+  }
+  const int rot_cols[3] = {kLsqYaw, kLsqTiltX, kLsqTiltY};
+  for (int c = 0; c < 3; ++c) {
+    const Vec3& w3 = cam.axis[c];
+    const Vec3 cross{d[1] * w3[2] - d[2] * w3[1], d[2] * w3[0] - d[0] * w3[2],
+                     d[0] * w3[1] - d[1] * w3[0]};  // [d]×·w = d × w
+    const Vec3 col = mat_vec(cam.rt, cross);
+    for (int row = 0; row < 3; ++row) dp[row][rot_cols[c]] = col[row];
+  }
+  for (int c = 0; c < kLsqVx; ++c) {
+    // ∂r/∂param = −f·∂(projection)/∂param
+    jx[c] = -fx * iz * (dp[0][c] - p[0] * iz * dp[2][c]);
+    jy[c] = -fy * iz * (dp[1][c] - p[1] * iz * dp[2][c]);
+  }
+  jx[kLsqVx] = pt.tau_s * jx[kLsqTx];
+  jx[kLsqVy] = pt.tau_s * jx[kLsqTy];
+  jx[kLsqYawRate] = pt.tau_s * jx[kLsqYaw];
+  jy[kLsqVx] = pt.tau_s * jy[kLsqTx];
+  jy[kLsqVy] = pt.tau_s * jy[kLsqTy];
+  jy[kLsqYawRate] = pt.tau_s * jy[kLsqYaw];
+}
+
+double residual2_px(const ViewGeometry& view, const LsqState& st, const LsqPoint& pt) {
+  Vec3 t_w;
+  Mat3 r_wc;
+  camera_at(st, pt.tau_s, &t_w, &r_wc);
+  const Vec3 p = mat_vec(mat_transpose(r_wc),
+                         {pt.world[0] - t_w[0], pt.world[1] - t_w[1], pt.world[2] - t_w[2]});
+  const double rx = normalized_residual_px(view.intrinsics().fx, pt.x_n, p[0], p[2]);
+  const double ry = normalized_residual_px(view.intrinsics().fy, pt.y_n, p[1], p[2]);
+  return rx * rx + ry * ry;
+}
+
+double accumulate(const ViewGeometry& view, const PositioningParams& params,
+                  std::span<const LsqPoint> points, std::span<const bool> use, const LsqState& st,
+                  bool with_jacobian, LsqNormal* a, LsqVector* b, double* sum_w_r2, int* count) {
+  const double k = params.lsq_huber_px;
+  const PointCamera centre = centre_camera(st);
+  if (with_jacobian) {
+    a->fill(0.0);
+    b->fill(0.0);
+  }
+  double cost = 0.0, wr2 = 0.0;
+  int n = 0;
+  for (const LsqPoint& pt : points) {
+    if (!use[pt.fix]) continue;
+    const PointCamera cam = point_camera(st, pt, centre, with_jacobian);
+    double rx = 0.0, ry = 0.0;
+    if (!point_residual(view, pt, cam, &rx, &ry)) return INFINITY;
+    const double r = std::sqrt(rx * rx + ry * ry);
+    const double w = r <= k ? 1.0 : k / r;
+    cost += r <= k ? r * r : 2.0 * k * r - k * k;
+    wr2 += w * r * r;
+    ++n;
+    if (!with_jacobian) continue;
+    double jx[kN], jy[kN];
+    point_jacobian(view, pt, cam, jx, jy);
+    for (int r1 = 0; r1 < kN; ++r1) {
+      (*b)[r1] -= w * (jx[r1] * rx + jy[r1] * ry);
+      for (int c = r1; c < kN; ++c) (*a)[r1 * kN + c] += w * (jx[r1] * jx[c] + jy[r1] * jy[c]);
+    }
+  }
+  if (with_jacobian) {
+    for (int r1 = 0; r1 < kN; ++r1)
+      for (int c = 0; c < r1; ++c) (*a)[r1 * kN + c] = (*a)[c * kN + r1];
+  }
+  *sum_w_r2 = wr2;
+  *count = n;
+  return cost;
+}
+
+// The motion's prior is the caller's motion, or rest with
+// lsq_motion_prior_mps / _radps per pixel of residual; the caller's sigmas are
+// floored. The tilt's soft prior keeps it near the mount's nominal tilt when
+// the points cannot separate it from translation; its weight is that of one
+// 1-pixel residual per lsq_tilt_prior_rad.
+double prior_cost(const ViewGeometry& view, const PositioningParams& params, const LsqModel& model,
+                  const LsqState& st, LsqNormal* a, LsqVector* b) {
+  double motion = 0.0;
+  const CameraMotion& told = model.motion;
+  if (model.motion_free()) {
+    const double wv =
+        1.0 / (told.valid ? std::max(told.sigma_v_mps, params.lsq_motion_prior_floor_mps)
+                          : params.lsq_motion_prior_mps);
+    const double ww =
+        1.0 / (told.valid ? std::max(told.sigma_yaw_rate_radps, params.lsq_motion_prior_floor_radps)
+                          : params.lsq_motion_prior_radps);
+    const LsqState held = held_motion(model, st);
+    const double r[3] = {wv * (st.vx - held.vx), wv * (st.vy - held.vy), ww * (st.w - held.w)};
+    const double wt[3] = {wv, wv, ww};
+    for (int k = 0; k < 3; ++k) {
+      motion += r[k] * r[k];
+      if (a == nullptr) continue;
+      (*a)[(kLsqVx + k) * kN + kLsqVx + k] += wt[k] * wt[k];
+      (*b)[kLsqVx + k] -= wt[k] * r[k];
+    }
+  }
+  if (!model.tilt_free()) return motion;
+  double ta = 0.0, tb = 0.0;
+  camera_tilt_of(st.r_wc, &ta, &tb);
+  const double w = 1.0 / params.lsq_tilt_prior_rad;
+  const double ra = w * (ta - view.mount().tilt_x_rad), rb = w * (tb - view.mount().tilt_y_rad);
+  if (a != nullptr) {
+    (*a)[kLsqTiltX * kN + kLsqTiltX] += w * w;
+    (*a)[kLsqTiltY * kN + kLsqTiltY] += w * w;
+    (*b)[kLsqTiltX] -= w * ra;
+    (*b)[kLsqTiltY] -= w * rb;
+  }
+  return motion + ra * ra + rb * rb;
+}
+
+LsqState held_motion(const LsqModel& model, const LsqState& st) {
+  LsqState out = st;
+  const CameraMotion& m = model.motion;
+  out.vx = m.valid ? m.vx_mps : 0.0;
+  out.vy = m.valid ? m.vy_mps : 0.0;
+  out.w = m.valid ? m.yaw_rate_radps : 0.0;
+  return out;
+}
+
+LsqState stepped(const LsqState& st, const LsqVector& step) {
+  LsqState out = st;
+  out.t_w[0] += step[kLsqTx];
+  out.t_w[1] += step[kLsqTy];
+  out.t_w[2] += step[kLsqTz];
+  const Mat3 lev = level_rotation(camera_yaw_of(st.r_wc));
+  Vec3 w{0.0, 0.0, step[kLsqYaw]};
+  for (int r = 0; r < 3; ++r)
+    w[r] += step[kLsqTiltX] * lev[r * 3] + step[kLsqTiltY] * lev[r * 3 + 1];
+  out.r_wc = mat_mul(exp_so3(w), st.r_wc);
+  out.vx += step[kLsqVx];
+  out.vy += step[kLsqVy];
+  out.w += step[kLsqYawRate];
+  return out;
+}
+
+}  // namespace ceilpose

@@ -1,0 +1,111 @@
+#pragma once
+// The least-squares problem's terms: its unknowns, the points it is solved
+// from, their pixel residuals and Jacobians, the priors, and the weighted
+// normal equations. The solve's steps (lsq_solver.cpp) and the covariance
+// (lsq_covariance.cpp) are both written on these. Allocation-free.
+//
+// Residuals are in pixels, r = f·(observed − projected) in undistorted
+// normalized coordinates (core/camera_model.h's normalized_residual_px).
+// Unknowns: the optical centre t (x, y, optionally z), a rotation increment
+// applied on the left, R ← Exp(ω)·R with ω = δψ·ẑ + δa·Xl + δb·Yl (Xl, Yl
+// the level camera's axes: δψ is exactly a yaw change, δa and δb tilt
+// changes), and, with a rolling shutter, the optical centre's velocity and
+// the yaw rate during the readout.
+#include <array>
+#include <span>
+
+#include "core/view_geometry.h"
+#include "pipeline/camera_motion.h"
+#include "pipeline/positioning_params.h"
+
+namespace ceilpose {
+
+inline constexpr int kLsqParams = 9;
+enum LsqParam : int {
+  kLsqTx = 0,
+  kLsqTy = 1,
+  kLsqYaw = 2,
+  kLsqTiltX = 3,
+  kLsqTiltY = 4,
+  kLsqTz = 5,
+  kLsqVx = 6,
+  kLsqVy = 7,
+  kLsqYawRate = 8
+};
+using LsqNormal = std::array<double, kLsqParams * kLsqParams>;
+using LsqVector = std::array<double, kLsqParams>;
+
+// One image point and the ceiling point it is of.
+struct LsqPoint {
+  double x_n, y_n;  // undistorted normalized observation (camera frame)
+  Vec3 world;       // marker point on the ceiling
+  int fix;          // index into the frame's marker fixes
+  double tau_s;     // when its row was exposed, after the centre row (rolling shutter)
+};
+
+// The camera at the centre row's instant, and its motion during the readout.
+struct LsqState {
+  Vec3 t_w{};                          // optical centre
+  Mat3 r_wc{};                         // camera axes in the world
+  double vx = 0.0, vy = 0.0, w = 0.0;  // optical centre velocity, yaw rate
+};
+
+// Which unknowns a fit frees, and the motion it holds them at or draws them
+// towards: passed to every step, never kept between solves.
+struct LsqModel {
+  std::array<bool, kLsqParams> active{};
+  CameraMotion motion;  // the caller's (rolling shutter), else invalid
+  bool tilt_free() const { return active[kLsqTiltX]; }
+  bool motion_free() const { return active[kLsqVx]; }
+  int free_count() const;
+};
+
+// What a point's residual and Jacobian need of its camera: Rᵀ, the
+// increment axes and d = P − t.
+struct PointCamera {
+  Vec3 d;
+  Mat3 rt;
+  std::array<Vec3, 3> axis;
+};
+
+// The camera at the centre row: Rᵀ and the world directions of the yaw and
+// the two tilt increments (the vertical and the level camera's axes).
+PointCamera centre_camera(const LsqState& st);
+
+// The camera when `pt`'s row was exposed; a global shutter's points reuse
+// `centre` (with_axes: also the increment axes, for the Jacobian).
+PointCamera point_camera(const LsqState& st, const LsqPoint& pt, const PointCamera& centre,
+                         bool with_axes);
+
+// The pixel residual (rx, ry) of `pt` seen by `cam`; false when the point is
+// behind the camera (the solve diverged).
+bool point_residual(const ViewGeometry& view, const LsqPoint& pt, const PointCamera& cam,
+                    double* rx, double* ry);
+
+// Jacobian of the pixel residual with respect to every unknown (LsqParam
+// order), motion columns included.
+void point_jacobian(const ViewGeometry& view, const LsqPoint& pt, const PointCamera& cam,
+                    double* jx, double* jy);
+
+// Squared reprojection residual of one point, pixels².
+double residual2_px(const ViewGeometry& view, const LsqState& st, const LsqPoint& pt);
+
+// Huber-weighted normal equations (with_jacobian) and the robust cost of
+// the points whose marker is in use; infinite when a point is behind the
+// camera. *sum_w_r2 and *count: the weighted squared residuals and points.
+double accumulate(const ViewGeometry& view, const PositioningParams& params,
+                  std::span<const LsqPoint> points, std::span<const bool> use, const LsqState& st,
+                  bool with_jacobian, LsqNormal* a, LsqVector* b, double* sum_w_r2, int* count);
+
+// The priors' cost, added to the normal equations when `a` is given: the
+// motion towards the caller's (or rest), the tilt towards the mount's.
+double prior_cost(const ViewGeometry& view, const PositioningParams& params, const LsqModel& model,
+                  const LsqState& st, LsqNormal* a, LsqVector* b);
+
+// `st` with the motion it is held at when the fit does not estimate it.
+LsqState held_motion(const LsqModel& model, const LsqState& st);
+
+// The state moved by a step of the unknowns.
+LsqState stepped(const LsqState& st, const LsqVector& step);
+
+}  // namespace ceilpose
