@@ -3,6 +3,7 @@
 #include <unistd.h>
 
 #include <cstdio>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 
@@ -29,6 +30,11 @@ void split_input(const uint8_t* data, size_t size, std::string_view* parts, int 
     parts[k] = rest.substr(0, at);
     rest = at == std::string_view::npos ? std::string_view() : rest.substr(at + kCut.size());
   }
+}
+
+void invariant_broken(const char* target, const std::string& what) {
+  std::fprintf(stderr, "%s: invariant broken: %s\n", target, what.c_str());
+  std::abort();
 }
 
 }  // namespace ceilpose::fuzz

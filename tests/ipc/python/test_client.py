@@ -4,6 +4,7 @@ its own segment, DDS off): latest, wait_next, predict and the errors.
 Run by ctest with CEILPOSE_CLIENT_LIBRARY (the built C client), PYTHONPATH
 (ipc/python) and CEILPOSED (the daemon) set; python3 from Debian."""
 
+import ctypes
 import math
 import os
 import subprocess
@@ -111,6 +112,21 @@ class ClientWithoutDaemon(unittest.TestCase):
 
     def test_the_record_layout_is_abi_3(self):
         self.assertEqual(ceilpose.ABI_VERSION, 3)
+
+    def test_every_field_sits_where_the_c_header_puts_it(self):
+        # The C compiler's offsets and sizes (pose_layout.c), field by field,
+        # and no field the header has that the module lacks, or the reverse.
+        out = subprocess.run([os.environ["CEILPOSE_POSE_LAYOUT"]], check=True,
+                             capture_output=True, text=True).stdout.split("\n")
+        c_fields = {}
+        for line in filter(None, out):
+            name, *numbers = line.split()
+            c_fields[name] = tuple(int(n) for n in numbers)
+        record = ceilpose._PoseRecord
+        self.assertEqual(c_fields.pop("sizeof"), (ctypes.sizeof(record),))
+        py_fields = {name: (getattr(record, name).offset, getattr(record, name).size)
+                     for name, _ in record._fields_}
+        self.assertEqual(py_fields, c_fields)
 
 
 if __name__ == "__main__":
