@@ -27,7 +27,7 @@ Result<std::vector<double>> matrix(const std::string& path, const YAML::Node& ro
   auto c = integer(path, m, "cols", std::string(key) + ".cols");
   if (!c) return c.error();
   const YAML::Node data = m["data"];
-  if (*r != rows || *c != cols || !data.IsSequence() ||
+  if (*r != rows || *c != cols || !data.IsDefined() || !data.IsSequence() ||
       data.size() != static_cast<size_t>(rows * cols)) {
     return make_error(where(path, m) + ": key '" + key + "' must be a " + shape + " matrix with " +
                       std::to_string(rows * cols) + " numbers in data");

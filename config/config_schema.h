@@ -170,6 +170,7 @@ void describe(V& v, ServiceConfig& c) {
     v.field("lsq_min_points", q.lsq_min_points, 3, 10000);
     v.field("lsq_estimate_tilt", q.lsq_estimate_tilt);
     v.field("lsq_tilt_select_chi2", q.lsq_tilt_select_chi2, 0.0, 1e6);
+    v.field("lsq_tilt_select_shift_sigmas", q.lsq_tilt_select_shift_sigmas, 0.0, 1e6);
     v.field("lsq_tilt_prior_rad", q.lsq_tilt_prior_rad, 1e-6, 1.0);
     v.field("lsq_max_tilt_rad", q.lsq_max_tilt_rad, 0.0, kPi / 2);
     v.field("lsq_tilt_min_markers", q.lsq_tilt_min_markers, 1, kMaxMarkersPerFrame);

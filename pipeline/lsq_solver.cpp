@@ -167,19 +167,43 @@ LsqSolver::Fit LsqSolver::choose_tilt_model(const ViewGeometry& view,
     out->tilt_choice = TiltChoice::kFreeFits;
     return free;
   }
+  // The evidence: how much better the free model explains the points, in
+  // units of its own noise; and what leaving the tilt out would cost: how
+  // far the free pose is from the held one, in units of the free pose's own
+  // standard deviation.
   LsqNormal a{};
   LsqVector b{};
   double wr2 = 0.0;
   int n = 0;
-  accumulate(view, params, points(), std::span<const bool>(free.use.data(), fixes.size()),
-             free.state, false, &a, &b, &wr2, &n);
-  const double sigma2 = free.cost / std::max(1, 2 * n - 5);
+  const std::span<const bool> free_use(free.use.data(), fixes.size());
+  accumulate(view, params, points(), free_use, free.state, true, &a, &b, &wr2, &n);
+  prior_cost(view, params, free.model, free.state, &a, &b);
+  const double sigma2 = free.cost / std::max(1, 2 * n - free.model.free_count());
   out->tilt_chi2 = sigma2 > 0.0 ? (held.cost - free.cost) / sigma2 : 0.0;
   out->tilt_shift_m =
       std::hypot(free.state.t_w[0] - held.state.t_w[0], free.state.t_w[1] - held.state.t_w[1]);
-  const bool better = held.cost - free.cost > params.lsq_tilt_select_chi2 * sigma2;
-  out->tilt_choice = better ? TiltChoice::kFreeFits : TiltChoice::kHeldFits;
-  return better ? free : held;
+  out->tilt_free_sigma_m = position_sigma_m(free.model, a, wr2, n);
+  const bool better = out->tilt_chi2 > params.lsq_tilt_select_chi2;
+  const bool matters =
+      out->tilt_shift_m > params.lsq_tilt_select_shift_sigmas * out->tilt_free_sigma_m;
+  out->tilt_choice = better && matters ? TiltChoice::kFreeFits : TiltChoice::kHeldFits;
+  return better && matters ? free : held;
+}
+
+// The 1-sigma of the optical centre's horizontal position, metres, from the
+// normal equations `a` of a fit whose Huber-weighted squared residuals are
+// wr2 over n points; infinite when `a` is singular.
+double LsqSolver::position_sigma_m(const LsqModel& model, const LsqNormal& a, double wr2,
+                                   int n) const {
+  const double sigma2 = wr2 / std::max(1, 2 * n - model.free_count());
+  double var_m2 = 0.0;
+  for (int axis : {kLsqTx, kLsqTy}) {
+    LsqVector e{}, g{};
+    e[axis] = 1.0;
+    if (!solve_spd<kLsqParams>(a, model.active, e, &g)) return INFINITY;
+    var_m2 += sigma2 * g[axis];
+  }
+  return std::sqrt(var_m2);
 }
 
 // Levenberg–Marquardt with Huber weights (IRLS) over the model's free

@@ -46,6 +46,7 @@ struct LsqResult {
   // held-tilt one, metres, and by how much freeing the tilt lowered the
   // cost, in units of the free fit's noise (chi-square).
   double tilt_shift_m = 0.0;
+  double tilt_free_sigma_m = 0.0;  // the free-tilt pose's own 1-sigma, metres
   double tilt_chi2 = 0.0;
   // Rolling shutter (camera.readout_ms > 0): the optical centre's velocity
   // and the yaw rate during the readout, world frame, when the markers span
@@ -96,6 +97,7 @@ class LsqSolver {
                    std::span<const MarkerFix> fixes, const Fit& fit) const;
   bool motion_observable(const ViewGeometry& view, const PositioningParams& params,
                          std::span<const bool> use, int marker_count) const;
+  double position_sigma_m(const LsqModel& model, const LsqNormal& a, double wr2, int n) const;
   double rms_px(const ViewGeometry& view, std::span<const bool> use, const LsqState& st,
                 int n) const;
   std::span<const LsqPoint> points() const { return {points_.data(), size_t(point_count_)}; }

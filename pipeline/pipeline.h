@@ -105,6 +105,8 @@ class Pipeline {
   std::span<const Component> components() const { return labeler_.components(); }
   std::span<const RectangleCandidate> rectangles() const { return {rects_.data(), rect_count_}; }
   std::span<const MarkerPair> pairs() const { return {pairs_.data(), pair_count_}; }
+  // The last frame's positioning in detail (the least-squares solve, its tilt choice).
+  const Positioner& positioner() const { return positioner_; }
 
  private:
   bool usable(const ImageView& frame) const;

@@ -38,15 +38,21 @@ struct PositioningParams {
   // nominal tilt (false). Tilt costs nothing and absorbs a camera that is not
   // quite level; hold it only for single-marker views (done automatically).
   bool lsq_estimate_tilt = true;
-  // The tilt is reported as estimated only when freeing it lowers the
-  // robust cost by more than this many times the residual variance (a
-  // likelihood-ratio test on 2 extra parameters). Far above chi²(2)'s 99.9%
-  // point (13.8) because real point errors are not Gaussian: at 13.8, 4% of
-  // level stress frames "found" a tilt of ~0.5° and lost 15–30 mm; at 100
-  // none did, and tilts above ~0.15° (3 mm of position) are still found.
-  // Estimating tilt costs ~10x the position noise of holding it, so it is
-  // freed only when the data show it. Lower to follow smaller tilts.
-  double lsq_tilt_select_chi2 = 100.0;
+  // The tilt decision (lsq_solver.cpp's choose_tilt_model): the free-tilt
+  // fit is chosen only when it lowers the robust cost by more than this many
+  // times its residual variance (a likelihood-ratio test on 2 extra
+  // parameters)... Above chi²(2)'s 99.99% point (18.4) because real point
+  // errors are not Gaussian. Measured on independent renders (tests/pipeline/
+  // tilt_decision_test.cpp, 2026-12-03): at 100 every tilt of 0.13–0.19° was
+  // left out and cost 5–7 mm; at 20, 1 level frame in 450 chose a tilt
+  // (3.1 mm off) and tilted frames of 0.1–3° kept p99 1.9 mm. Lower to
+  // follow smaller tilts, raise if level views find tilts.
+  double lsq_tilt_select_chi2 = 20.0;
+  // ... and only when leaving the tilt out would cost position: the free
+  // pose must lie more than this many of its own standard deviations from
+  // the held one. Below that either answer is as good, and holding the tilt
+  // is the more precise.
+  double lsq_tilt_select_shift_sigmas = 2.0;
   // Prior standard deviation of the tilt about the nominal mount tilt,
   // radians, weighted as one 1-pixel residual. A guard against divergence on
   // few, clustered points, weak enough not to bias a real tilt.

@@ -84,7 +84,11 @@ INSTANTIATE_TEST_SUITE_P(
         BadInfo{"NaN", replaced("-0.08", ".nan"),
                 "distortion_coefficients.data[0] must be a finite"},
         BadInfo{"NoWidth", replaced("image_width: 640\n", ""), "missing key 'image_width'"},
-        BadInfo{"Syntax", replaced("data: [-0.08", "data: [[-0.08"), "YAML syntax error"}),
+        BadInfo{"Syntax", replaced("data: [-0.08", "data: [[-0.08"), "YAML syntax error"},
+        // Found by fuzz_camera_info: a matrix without `data` threw out of the
+        // reader (yaml-cpp's InvalidNode) and ended the process.
+        BadInfo{"NoData", replaced("data: [-0.08", "dAta: [-0.08"),
+                "'distortion_coefficients' must be a 1 x 5 matrix"}),
     [](const auto& info) { return std::string(info.param.name); });
 
 TEST(CalibrationFiles, ACameraOfAnotherSizeIsAnErrorNotARescale) {

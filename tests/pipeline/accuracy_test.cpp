@@ -59,8 +59,9 @@ TEST(Accuracy, StressSetStaysNearItsMeasuredAccuracy) {
 }
 
 TEST(Accuracy, TiltedCameraWithLeastSquaresStaysNearItsMeasuredAccuracy) {
-  // 0.48 / 2.84 mm, 0.009 deg
-  expect_row({"tilt", PositioningMode::kLeastSquares, 1.0, 1.0, 0.96, 5.7, 0.018});
+  // 0.47 / 2.57 mm, 0.009 deg (2026-12-03; 0.48 / 2.84 mm before the tilt
+  // decision weighed what leaving the tilt out costs)
+  expect_row({"tilt", PositioningMode::kLeastSquares, 1.0, 1.0, 0.94, 5.2, 0.018});
 }
 
 TEST(Accuracy, FramesWithoutWholeMarkerAreInvalidAndEdgesHaveNoGrossError) {

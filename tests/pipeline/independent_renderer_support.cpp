@@ -43,10 +43,17 @@ class Projector {
     const double centre_y_m = robot.y_m + s * mount.offset_forward_m + c * mount.offset_left_m;
     const double cam_yaw_rad = robot.yaw_rad + mount.yaw_rad;
     const double cc = std::cos(cam_yaw_rad), cs = std::sin(cam_yaw_rad);
-    // Rows of R_cw are the camera axes expressed in the world (SPEC §3).
-    const cv::Matx33d r_cw(-cs, cc, 0.0,   //
-                           -cc, -cs, 0.0,  //
-                           0.0, 0.0, 1.0);
+    // Rows of the level camera's R_cw are its axes expressed in the world
+    // (SPEC §3); a tilted camera turns them about its own Xc by tilt_x, then
+    // about the turned Yc by tilt_y: R_wc = L·Rx·Ry, so R_cw = Ryᵀ·Rxᵀ·Lᵀ.
+    const cv::Matx33d level_cw(-cs, cc, 0.0,   //
+                               -cc, -cs, 0.0,  //
+                               0.0, 0.0, 1.0);
+    const double ca = std::cos(mount.tilt_x_rad), sa = std::sin(mount.tilt_x_rad);
+    const double cb = std::cos(mount.tilt_y_rad), sb = std::sin(mount.tilt_y_rad);
+    const cv::Matx33d rx(1.0, 0.0, 0.0, 0.0, ca, -sa, 0.0, sa, ca);
+    const cv::Matx33d ry(cb, 0.0, sb, 0.0, 1.0, 0.0, -sb, 0.0, cb);
+    const cv::Matx33d r_cw = ry.t() * rx.t() * level_cw;
     const cv::Vec3d centre_w(centre_x_m, centre_y_m, mount.lens_height_m);
     cv::Rodrigues(cv::Mat(r_cw), rvec_);
     tvec_ = cv::Mat(-(r_cw * centre_w));

@@ -33,6 +33,10 @@ struct XMount {
   double offset_forward_m = 0.0;
   double offset_left_m = 0.0;
   double yaw_rad = 0.0;
+  // Tilt of the camera about its own image-right axis, then about its
+  // image-down axis (SPEC §3: the axes rotate about the optical centre).
+  double tilt_x_rad = 0.0;
+  double tilt_y_rad = 0.0;
 };
 
 // How the frame departs from the ideal print: supersampling factor, a camera
