@@ -37,6 +37,8 @@ struct Localization {
   // published pose is invalid: the same, or kNone while coasting.
   Refusal refusal = Refusal::kNone;
   int markers_decoded = 0;  // markers the pipeline decoded
+  // Of those, how many the reconcile step believed, and why not the others.
+  ReconcileCounts reconcile;
   // The decoded markers themselves (the survey's observations); valid until
   // the next frame is localized.
   std::span<const MarkerObservation> markers;

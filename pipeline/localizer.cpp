@@ -34,6 +34,7 @@ const Localization& Localizer::localize(const ImageView& image, const FrameInfo&
   out_.frame = frame;
   out_.measured = result_->estimate;
   out_.markers_decoded = result_->marker_count;
+  out_.reconcile = result_->reconcile;
   out_.image = image;
   out_.detection = &pipeline_;
   out_.markers = std::span<const MarkerObservation>(result_->markers.data(),

@@ -55,6 +55,8 @@ const char* Pipeline::stage_name(int stage) {
       return "pairing";
     case kStageDecoding:
       return "decoding";
+    case kStageReconcile:
+      return "reconcile";
     case kStagePositioning:
       return "positioning";
     default:
@@ -166,6 +168,7 @@ void Pipeline::process(const ImageView& frame, PositioningMode mode, FrameResult
   out->noisy = false;
   out->unit_gains = false;
   out->stage_ns.fill(0);
+  out->reconcile = ReconcileCounts{};
   rect_count_ = 0;
   pair_count_ = 0;
   if (!usable(frame)) {
@@ -200,12 +203,18 @@ void Pipeline::process(const ImageView& frame, PositioningMode mode, FrameResult
   }
   lap(kStageDecoding);
 
-  // 5. Positioning.
+  // 5. Reconcile: which decoded markers to believe.
+  const std::span<const MarkerObservation> decoded(out->markers.data(), out->marker_count);
+  if (out->marker_count > 0) positioner_.reconcile(decoded, motion);
+  lap(kStageReconcile);
+
+  // 6. Positioning.
   if (out->marker_count == 0) {
     out->estimate = refused_estimate(refusal_without_markers(*out, pair_count_));
+    out->reconcile = ReconcileCounts{};
   } else {
-    out->estimate =
-        positioner_.solve(std::span(out->markers.data(), out->marker_count), mode, motion);
+    out->estimate = positioner_.position(decoded, mode, motion);
+    out->reconcile = positioner_.reconcile_counts();
   }
   lap(kStagePositioning);
   out->total_ns = stamp_ns - start_ns;

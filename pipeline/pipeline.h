@@ -26,7 +26,8 @@ enum PipelineStage : int {
   kStageRectangles,      // rectangle template fit
   kStagePairing,         // red/green pairing and heading
   kStageDecoding,        // dot reading, code and geometry checks, points
-  kStagePositioning,     // Positioner::solve
+  kStageReconcile,       // which decoded markers to believe (Positioner::reconcile)
+  kStagePositioning,     // Positioner::position
   kStageCount
 };
 
@@ -76,6 +77,7 @@ struct FrameResult {
   bool unit_gains = false;  // no tile to take the colour reference from
   std::array<int64_t, kStageCount> stage_ns{};  // duration of each stage
   int64_t total_ns = 0;
+  ReconcileCounts reconcile;  // which decoded markers were believed, why not the others
 };
 
 class Pipeline {

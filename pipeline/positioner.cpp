@@ -124,40 +124,73 @@ PoseEstimate Positioner::least_squares(std::span<const MarkerObservation> marker
 
 PoseEstimate Positioner::solve(std::span<const MarkerObservation> markers, PositioningMode mode,
                                const CameraMotion& motion) {
+  reconcile(markers, motion);
+  return position(markers, mode, motion);
+}
+
+// The reconcile step: which decoded markers to believe, and why each other
+// one is not, in a fixed order (whole, mapped, clear enough alone, agreeing
+// with the majority); then whether the believed ones agree with the
+// configured heights.
+Refusal Positioner::reconcile(std::span<const MarkerObservation> markers,
+                              const CameraMotion& motion) {
+  counts_ = ReconcileCounts{};
+  fix_count_ = inliers_ = 0;
+  depth_scale_ = 0.0;
   // 1. What each whole marker says on its own (Change of Axes), at the
   // centre row's instant when the motion during the readout is known.
-  int fix_count = 0, whole = 0;
+  int whole = 0;
   const int n = static_cast<int>(std::min<size_t>(markers.size(), kMaxMarkersPerFrame));
   for (int k = 0; k < n; ++k) {
-    if (!markers[k].whole) continue;
+    if (!markers[k].whole) {
+      ++counts_.cut_off;
+      continue;
+    }
     ++whole;
-    if (marker_fix(view_, markers[k], k, motion, &fixes_[fix_count])) ++fix_count;
+    if (marker_fix(view_, markers[k], k, motion, &fixes_[fix_count_]))
+      ++fix_count_;
+    else
+      ++counts_.unmapped;
   }
-  if (fix_count == 0)
-    return refused_estimate(whole > 0 && view_.map().surveyed() ? Refusal::kUnmappedMarkers
-                                                                : Refusal::kNoWholeMarker);
-  if (fix_count == 1 && markers[fixes_[0].index].quality < kLoneMarkerMinQuality)
-    return refused_estimate(Refusal::kLoneMarkerUnclear);
+  if (fix_count_ == 0)
+    return refusal_ = whole > 0 && view_.map().surveyed() ? Refusal::kUnmappedMarkers
+                                                          : Refusal::kNoWholeMarker;
+  if (fix_count_ == 1 && markers[fixes_[0].index].quality < kLoneMarkerMinQuality) {
+    counts_.lone_unclear = 1;
+    return refusal_ = Refusal::kLoneMarkerUnclear;
+  }
   // 2. Keep the markers that agree on where the camera is.
-  const int inliers =
-      grid_consistent_subset(params_, view_.layout().grid_m, std::span(fixes_.data(), fix_count),
-                             std::span(inlier_.data(), fix_count));
-  if (inliers == 0) return refused_estimate(Refusal::kInconsistentMarkers);
+  inliers_ =
+      grid_consistent_subset(params_, view_.layout().grid_m, std::span(fixes_.data(), fix_count_),
+                             std::span(inlier_.data(), fix_count_));
+  counts_.inconsistent = fix_count_ - inliers_;
+  if (inliers_ == 0) return refusal_ = Refusal::kInconsistentMarkers;
+  counts_.believed = inliers_;
   // 3. The configured heights must match what the markers' spacing says.
-  const double scale = depth_scale(fix_count);
-  if (depth_scale_contradicts_heights(params_, scale))
-    return refused_estimate(Refusal::kWrongHeights, scale);
+  depth_scale_ = depth_scale(fix_count_);
+  if (depth_scale_contradicts_heights(params_, depth_scale_))
+    return refusal_ = Refusal::kWrongHeights;
+  return refusal_ = Refusal::kNone;
+}
+
+PoseEstimate Positioner::position(std::span<const MarkerObservation> markers, PositioningMode mode,
+                                  const CameraMotion& motion) {
+  if (refusal_ != Refusal::kNone) return refused_estimate(refusal_, depth_scale_);
   // 4. The mode asked for, or in auto the best the view allows.
-  PoseEstimate est = solve_mode(markers, fix_count, mode, motion);
-  est.depth_scale = scale;
-  if (est.valid) time_the_pose(markers, fix_count, motion, &est);
+  PoseEstimate est = solve_mode(markers, fix_count_, mode, motion);
+  est.depth_scale = depth_scale_;
+  if (est.valid && est.mode == PositioningMode::kLeastSquares) {
+    counts_.residual = lsq_result_.rejected;
+    counts_.believed -= lsq_result_.rejected;
+  }
+  if (est.valid) time_the_pose(markers, fix_count_, motion, &est);
   if (!est.valid) {
     // A solver given fewer markers than it needs did not fail: the view did.
     int inlier_points = 0;
-    for (int k = 0; k < fix_count; ++k)
+    for (int k = 0; k < fix_count_; ++k)
       if (inlier_[k]) inlier_points += markers[fixes_[k].index].point_count;
     const bool too_few =
-        (mode == PositioningMode::kBarycentric && inliers < 3) ||
+        (mode == PositioningMode::kBarycentric && inliers_ < 3) ||
         (mode == PositioningMode::kLeastSquares && inlier_points < params_.lsq_min_points);
     est.refusal = too_few ? Refusal::kTooFewMarkers : Refusal::kSolverRejected;
   }

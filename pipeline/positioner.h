@@ -12,6 +12,19 @@
 
 namespace ceilpose {
 
+// The reconcile step's account of one frame: how many decoded markers were
+// believed, and why each other one was not. lsq's residual rejections are
+// counted by the positioning that follows it.
+struct ReconcileCounts {
+  int believed = 0;      // passed to positioning
+  int cut_off = 0;       // not wholly in view: a cut-off marker's code may be misread
+  int unmapped = 0;      // not on the map (or its red and green centres coincide)
+  int lone_unclear = 0;  // the only marker, its dots too faint to trust without another
+  int inconsistent = 0;  // disagrees with the majority on where the camera is
+  int residual = 0;      // lsq rejected it: its points do not fit the pose
+  int rejected() const { return cut_off + unmapped + lone_unclear + inconsistent + residual; }
+};
+
 // Not thread-safe: one instance per pipeline thread. solve() allocates
 // nothing and throws nothing.
 class Positioner {
@@ -27,6 +40,16 @@ class Positioner {
   // it, and lsq holds it when the rows cannot tell the motion.
   PoseEstimate solve(std::span<const MarkerObservation> markers, PositioningMode mode,
                      const CameraMotion& motion = {});
+
+  // solve() in its two steps, which the pipeline times apart. reconcile()
+  // decides which decoded markers to believe (whole, mapped, clear enough
+  // alone, grid-consistent, at the configured heights); kNone when some are,
+  // else the refusal. position() then solves the mode from the believed ones.
+  Refusal reconcile(std::span<const MarkerObservation> markers, const CameraMotion& motion);
+  PoseEstimate position(std::span<const MarkerObservation> markers, PositioningMode mode,
+                        const CameraMotion& motion);
+  // The last frame's reconcile, with position()'s residual rejections.
+  const ReconcileCounts& reconcile_counts() const { return counts_; }
 
   // Details of the last least-squares solve (tilt, iterations), for
   // diagnostics and tests.
@@ -45,6 +68,11 @@ class Positioner {
                      const CameraMotion& motion, PoseEstimate* est) const;
 
   PositioningParams params_;
+  ReconcileCounts counts_;
+  int fix_count_ = 0;
+  int inliers_ = 0;
+  double depth_scale_ = 0.0;
+  Refusal refusal_ = Refusal::kNone;
   ViewGeometry view_;
   LsqSolver lsq_;
   LsqResult lsq_result_;

@@ -167,6 +167,27 @@ TEST(Positioning, OutlierMarkerDoesNotMoveAnyMode) {
   }
 }
 
+// The reconcile step says why each marker it does not believe was left out.
+TEST(Positioning, ReconcileCountsWhyEachMarkerWasNotBelieved) {
+  PipelineConfig config;
+  Positioner positioner(config);
+  testing::SyntheticView view;
+  auto markers = testing::observe(view, {2.3, 1.8, -2.0});
+  ASSERT_GE(markers.size(), 6u);
+  markers[0].code_j ^= 1;  // misread: grid-inconsistent
+  markers[1].whole = false;
+  markers[2].code_i = 40;  // outside the layout: not on the map
+  EXPECT_EQ(positioner.reconcile(markers, {}), Refusal::kNone);
+  const ReconcileCounts& c = positioner.reconcile_counts();
+  EXPECT_EQ(c.inconsistent, 1);
+  EXPECT_EQ(c.cut_off, 1);
+  EXPECT_EQ(c.unmapped, 1);
+  EXPECT_EQ(c.lone_unclear, 0);
+  EXPECT_EQ(c.believed + c.rejected(), static_cast<int>(markers.size()));
+  EXPECT_TRUE(positioner.position(markers, PositioningMode::kLeastSquares, {}).valid);
+  EXPECT_EQ(positioner.reconcile_counts().residual, 0);
+}
+
 TEST(Positioning, NonFiniteObservationGivesInvalidNotGarbage) {
   PipelineConfig config;
   Positioner positioner(config);
