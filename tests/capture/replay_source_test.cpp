@@ -19,6 +19,11 @@ namespace fs = std::filesystem;
 
 constexpr int kFrames = 10;
 constexpr int64_t kInterval_ns = 20'000'000;
+// How late a paced frame may be delivered after its schedule: far above a
+// loaded CI machine's scheduling delay (tens of ms), far below what a source
+// that sleeps in the wrong unit (20 ms read as 20 s) or past its schedule
+// accumulates. The schedule itself is checked exactly.
+constexpr int64_t kMaxLatenessNs = 1'000'000'000;
 
 // A small recording: kFrames 32x24 frames, 20 ms apart, with ground truth
 // x = index, and pixel (0,0) red = index.
@@ -99,6 +104,7 @@ TEST_F(ReplaySourceTest, RealTimePacingFollowsTheRecordedTimestamps) {
     // The schedule is exact; delivery is never early (absolute sleeps).
     EXPECT_EQ(f.capture_ns - first_capture_ns, i * kInterval_ns);
     EXPECT_GE(f.dequeue_ns, f.capture_ns);
+    EXPECT_LT(f.dequeue_ns - f.capture_ns, kMaxLatenessNs) << "frame " << i;
     last_dequeue_ns = f.dequeue_ns;
     source.release(f);
   }
@@ -118,6 +124,8 @@ TEST_F(ReplaySourceTest, ASpeedFactorDividesTheRecordedIntervals) {
     if (i == 0) first_ns = f.capture_ns;
     EXPECT_EQ(f.capture_ns - first_ns, i * kInterval_ns / 4);
     EXPECT_GE(f.dequeue_ns, f.capture_ns);
+    // Nor late (kMaxLatenessNs).
+    EXPECT_LT(f.dequeue_ns - f.capture_ns, kMaxLatenessNs) << "frame " << i;
     source.release(f);
   }
 }

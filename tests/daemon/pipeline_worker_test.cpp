@@ -16,6 +16,7 @@
 #include "ipc/shm/shm_pose_reader.h"
 #include "ipc/shm/shm_pose_writer.h"
 #include "sim/trajectory_camera.h"
+#include "tests/support/alloc_count.h"
 
 namespace ceilpose::daemon {
 namespace {
@@ -192,6 +193,34 @@ TEST(PipelineWorker, EveryFrameReachesEverySinkWithItsRefusal) {
   uint64_t counted = 0;
   for (uint64_t n : counting.last_refusals) counted += n;
   EXPECT_EQ(counted, worker.frames()) << "the last status holds every frame's refusal";
+}
+
+// The worker's loop promises no allocation per frame: dequeue, localize,
+// every sink (here the shared-memory one) and the status records. A sink
+// placed first counts, on the worker thread, from the end of one frame to
+// the start of a frame kFrames later.
+constexpr uint64_t kWindowFirst = 10, kWindowFrames = 20;
+
+TEST(PipelineWorker, TheFrameLoopAllocatesNothing) {
+  struct AllocationWindow final : PublishingSink {
+    void consume(const Localization&) override {
+      ++frames;
+      if (frames == kWindowFirst) test::start_counting_allocations();
+      if (frames == kWindowFirst + kWindowFrames) allocations = test::stop_counting_allocations();
+    }
+    void publish_status(const ServiceStatus&) override {}
+    int64_t status_period_ns() const override { return 20'000'000; }
+    uint64_t frames = 0;
+    long allocations = -1;
+  };
+  Rig rig;
+  AllocationWindow window;
+  rig.sinks.insert(rig.sinks.begin(), &window);
+  PipelineWorker worker(rig.config, WorkerOptions{}, rig.capture.get(), rig.sinks, &rig.progress);
+  worker.start();
+  ASSERT_TRUE(wait_frames(worker, kWindowFirst + kWindowFrames + 1));
+  worker.stop();
+  EXPECT_EQ(window.allocations, 0) << "over " << kWindowFrames << " frames";
 }
 
 }  // namespace

@@ -7,6 +7,7 @@
 #include <cmath>
 
 #include "sim/renderer.h"
+#include "tests/support/alloc_count.h"
 
 namespace ceilpose {
 namespace {
@@ -114,6 +115,25 @@ TEST_F(LocalizerTest, ReconfigureSwitchesModeAndFilterBetweenFrames) {
   const Localization& axes = localizer.localize(ceiling.view(), next_frame());
   EXPECT_FALSE(axes.filtered);
   EXPECT_EQ(axes.published.mode, PositioningMode::kChangeOfAxes);
+}
+
+// localize() promises no allocation per frame with everything on: the
+// filter, a rolling shutter (the readout motion it predicts and lsq's motion
+// unknowns) and a camera that moves, with a missing frame in between.
+TEST_F(LocalizerTest, LocalizeWithFilterAndRollingShutterAllocatesNothing) {
+  PipelineConfig config = with_mode(config_, PositioningMode::kAuto, true);
+  config.intrinsics.readout_ms = 25.0;
+  Localizer localizer(config);
+  const Image a = frame_at({2.0, 2.0, 0.4}), b = frame_at({2.02, 2.0, 0.41});
+  for (int k = 0; k < 4; ++k) localizer.localize((k % 2 ? b : a).view(), next_frame());  // warm-up
+  test::start_counting_allocations();
+  int valid = 0;
+  for (int k = 0; k < 6; ++k) {
+    const Image& image = k == 3 ? black_ : k % 2 ? b : a;
+    valid += localizer.localize(image.view(), next_frame()).published.valid ? 1 : 0;
+  }
+  EXPECT_EQ(test::stop_counting_allocations(), 0);
+  EXPECT_EQ(valid, 6) << "coasting through the black frame counts as published";
 }
 
 TEST(RefusalNames, AreSnakeCaseUniqueAndStable) {

@@ -48,9 +48,11 @@ TEST_F(ShmLifecycle, ReaderWaitingBeforeWriterStartsAttachesWhenItAppears) {
     if (!self.wait_for_parent(kHandshakeMs)) return 11;
     return publishing_writer(name(), 3)(self);
   });
-  // The reader starts waiting first; the writer is released only afterwards.
+  // The reader waits first; the writer is released only once it is seen
+  // blocked in its wait for the segment.
+  const pid_t reader_tid = ::gettid();
   late_writer_starter = std::thread([&] {
-    std::this_thread::sleep_for(std::chrono::milliseconds(100));
+    EXPECT_TRUE(test::wait_until_blocked_in(reader_tid, test::poll_syscalls(), kHandshakeMs));
     child.release_child();
   });
   ShmErrc code = ShmErrc::kOk;
@@ -96,8 +98,9 @@ TEST_F(ShmLifecycle, MarkStoppedIsSeenAsStoppedAndSegmentStays) {
 
 TEST_F(ShmLifecycle, BlockedReaderReturnsStoppedWhenWriterStops) {
   ASSERT_NO_FATAL_FAILURE(start());
+  const pid_t reader_tid = ::gettid();
   std::thread stopper([&] {
-    std::this_thread::sleep_for(std::chrono::milliseconds(50));
+    EXPECT_TRUE(test::wait_until_blocked_in(reader_tid, test::futex_syscalls(), kHandshakeMs));
     writer().mark_stopped();
   });
   PoseRecord p;
@@ -178,8 +181,9 @@ TEST_F(ShmLifecycle, BlockedReaderLearnsThatWriterWasKilled) {
   ASSERT_TRUE(child.wait_for_child(kHandshakeMs));
   auto reader = ShmPoseReader::open(name());
   ASSERT_TRUE(reader) << reader.error().message;
+  const pid_t reader_tid = ::gettid();
   std::thread killer([&] {
-    std::this_thread::sleep_for(std::chrono::milliseconds(50));
+    EXPECT_TRUE(test::wait_until_blocked_in(reader_tid, test::futex_syscalls(), kHandshakeMs));
     child.kill_child(SIGKILL);
     child.wait_exit(20'000);  // reaped: a zombie still answers kill(pid, 0)
   });

@@ -4,12 +4,18 @@
 #include <gtest/gtest.h>
 #include <poll.h>
 #include <signal.h>
+#include <sys/syscall.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
 #include <cerrno>
+#include <chrono>
 #include <cstdlib>
 #include <cstring>
+#include <fstream>
+#include <string>
+#include <thread>
+#include <vector>
 
 #include "core/clock.h"
 
@@ -146,6 +152,31 @@ void ShmFixture::start(int heartbeat_period_ms, int stale_after_ms) {
   auto reader = ShmPoseReader::open(name());
   ASSERT_TRUE(reader) << reader.error().message;
   reader_.emplace(std::move(reader.value()));
+}
+
+bool wait_until_blocked_in(pid_t tid, const std::vector<long>& syscalls, int timeout_ms) {
+  const std::string path = "/proc/self/task/" + std::to_string(tid) + "/syscall";
+  const int64_t deadline_ns = monotonic_ns() + int64_t{timeout_ms} * 1'000'000;
+  while (monotonic_ns() < deadline_ns) {
+    std::ifstream in(path);
+    long nr = -1;
+    if (in >> nr) {  // "running" when it is not in a syscall: no number
+      for (long s : syscalls)
+        if (nr == s) return true;
+    }
+    std::this_thread::sleep_for(std::chrono::milliseconds(1));
+  }
+  return false;
+}
+
+std::vector<long> futex_syscalls() { return {SYS_futex}; }
+
+std::vector<long> poll_syscalls() {
+#ifdef SYS_poll
+  return {SYS_poll, SYS_ppoll};
+#else
+  return {SYS_ppoll};  // aarch64 has ppoll only
+#endif
 }
 
 }  // namespace ceilpose::test

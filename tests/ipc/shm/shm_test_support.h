@@ -9,6 +9,7 @@
 #include <functional>
 #include <optional>
 #include <string>
+#include <vector>
 
 #include "ipc/shm/pose_record.h"
 #include "ipc/shm/shm_pose_reader.h"
@@ -99,5 +100,15 @@ class ShmFixture : public ::testing::Test {
   std::optional<ShmPoseWriter> writer_;
   std::optional<ShmPoseReader> reader_;
 };
+
+// Waits up to timeout_ms until thread `tid` of this process sits blocked in
+// one of `syscalls` (numbers from <sys/syscall.h>), as /proc/self/task/TID/
+// syscall shows it: the handshake that proves a reader really blocked before
+// the event it waits for, instead of a sleep that only makes it likely.
+bool wait_until_blocked_in(pid_t tid, const std::vector<long>& syscalls, int timeout_ms);
+
+// The syscalls a blocked wait_next() and a waiting open_waiting() sit in.
+std::vector<long> futex_syscalls();
+std::vector<long> poll_syscalls();
 
 }  // namespace ceilpose::test
