@@ -11,6 +11,17 @@ namespace {
 
 using namespace calibration_detail;
 
+// SPEC §8's keys of a marker entry: read, checked and written from here.
+namespace key {
+constexpr const char* kCode = "code";
+constexpr const char* kX = "x_m";
+constexpr const char* kY = "y_m";
+constexpr const char* kYaw = "yaw_rad";
+constexpr const char* kSigma = "sigma_m";
+constexpr const char* kSigmaYaw = "sigma_yaw_rad";
+constexpr const char* kObservations = "observations";
+}  // namespace key
+
 // The map's ceiling must be the configured one: a map surveyed under another
 // height or grid would place every marker wrongly without any error.
 Result<void> check_ceiling(const std::string& path, const YAML::Node& root,
@@ -47,13 +58,14 @@ Result<void> read_marker(const std::string& path, const YAML::Node& node, size_t
                          CeilingMap* map) {
   const std::string name = "markers[" + std::to_string(index) + "]";
   if (!node.IsMap()) return make_error(where(path, node) + ": " + name + " must be a mapping");
-  if (auto known = only_keys(
-          path, node, {"code", "x_m", "y_m", "yaw_rad", "sigma_m", "sigma_yaw_rad", "observations"},
-          name);
+  if (auto known = only_keys(path, node,
+                             {key::kCode, key::kX, key::kY, key::kYaw, key::kSigma, key::kSigmaYaw,
+                              key::kObservations},
+                             name);
       !known) {
     return known;
   }
-  const YAML::Node code = node["code"];
+  const YAML::Node code = node[key::kCode];
   int ij[2] = {0, 0};
   // A missing key is an invalid node, whose type yaml-cpp throws for
   // (found by fuzz_map).
@@ -83,9 +95,9 @@ Result<void> read_marker(const std::string& path, const YAML::Node& node, size_t
     bool non_negative;
   };
   for (const Field& f :
-       {Field{"x_m", &p.x_m, nullptr, false}, Field{"y_m", &p.y_m, nullptr, false},
-        Field{"yaw_rad", &p.yaw_rad, &zero, false}, Field{"sigma_m", &p.sigma_m, &zero, true},
-        Field{"sigma_yaw_rad", &p.sigma_yaw_rad, &zero, true}}) {
+       {Field{key::kX, &p.x_m, nullptr, false}, Field{key::kY, &p.y_m, nullptr, false},
+        Field{key::kYaw, &p.yaw_rad, &zero, false}, Field{key::kSigma, &p.sigma_m, &zero, true},
+        Field{key::kSigmaYaw, &p.sigma_yaw_rad, &zero, true}}) {
     auto v = finite_number(path, node, f.key, entry + "." + f.key, f.fallback);
     if (!v) return v.error();
     if (f.non_negative && *v < 0.0)
@@ -93,11 +105,11 @@ Result<void> read_marker(const std::string& path, const YAML::Node& node, size_t
     *f.dst = *v;
   }
   const int none = 0;
-  auto obs = integer(path, node, "observations", entry + ".observations", &none);
+  auto obs = integer(path, node, key::kObservations, entry + "." + key::kObservations, &none);
   if (!obs) return obs.error();
   if (*obs < 0)
-    return make_error(where(path, node["observations"]) + ": " + entry +
-                      ".observations is negative");
+    return make_error(where(path, node[key::kObservations]) + ": " + entry + "." +
+                      key::kObservations + " is negative");
   p.observations = *obs;
   map->set(ij[0], ij[1], p);
   return {};
@@ -163,9 +175,10 @@ std::string map_text(const CeilingMap& map, const CeilingLayout& layout) {
       const MarkerPlacement* p = map.find(i, j);
       if (p == nullptr) continue;
       std::snprintf(line, sizeof line,
-                    "  - code: [%d, %d]\n    x_m: %.6f\n    y_m: %.6f\n    yaw_rad: %.7f\n    "
-                    "sigma_m: %.7f\n    sigma_yaw_rad: %.7f\n    observations: %d\n",
-                    i, j, p->x_m, p->y_m, p->yaw_rad, p->sigma_m, p->sigma_yaw_rad,
+                    "  - %s: [%d, %d]\n    %s: %.6f\n    %s: %.6f\n    %s: %.7f\n    %s: %.7f\n"
+                    "    %s: %.7f\n    %s: %d\n",
+                    key::kCode, i, j, key::kX, p->x_m, key::kY, p->y_m, key::kYaw, p->yaw_rad,
+                    key::kSigma, p->sigma_m, key::kSigmaYaw, p->sigma_yaw_rad, key::kObservations,
                     p->observations);
       out += line;
     }

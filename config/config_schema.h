@@ -79,14 +79,15 @@ void describe(V& v, ServiceConfig& c) {
   PipelineConfig& p = c.pipeline;
   v.section("camera", [&] {
     CameraIntrinsics& k = p.intrinsics;
-    v.field("width", k.width, 1, kMaxImageSidePx);
-    v.field("height", k.height, 1, kMaxImageSidePx);
-    v.field("fx", k.fx, 1.0, 1e6);
-    v.field("fy", k.fy, 1.0, 1e6);
-    v.field("cx", k.cx, -1e5, 1e5);
-    v.field("cy", k.cy, -1e5, 1e5);
-    v.numbers("distortion", k.distortion);
-    v.field("readout_ms", k.readout_ms, 0.0, 1000.0);
+    namespace key = camera_keys;
+    v.field(key::kWidth, k.width, 1, kMaxImageSidePx);
+    v.field(key::kHeight, k.height, 1, kMaxImageSidePx);
+    v.field(key::kFx, k.fx, 1.0, 1e6);
+    v.field(key::kFy, k.fy, 1.0, 1e6);
+    v.field(key::kCx, k.cx, -1e5, 1e5);
+    v.field(key::kCy, k.cy, -1e5, 1e5);
+    v.numbers(key::kDistortion, k.distortion);
+    v.field(key::kReadoutMs, k.readout_ms, 0.0, kMaxReadoutMs);
     v.text("calibration_file", c.calibration.camera_file, check_any_text);
   });
   v.section("mount", [&] {

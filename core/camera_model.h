@@ -28,6 +28,22 @@ struct CameraIntrinsics {
   bool operator==(const CameraIntrinsics&) const = default;
 };
 
+// The camera's keys (SPEC §3, §4): recording.yaml's camera block, the
+// configuration's camera section and `inspect` name them alike.
+namespace camera_keys {
+inline constexpr const char* kWidth = "width";
+inline constexpr const char* kHeight = "height";
+inline constexpr const char* kFx = "fx";
+inline constexpr const char* kFy = "fy";
+inline constexpr const char* kCx = "cx";
+inline constexpr const char* kCy = "cy";
+inline constexpr const char* kDistortion = "distortion";
+inline constexpr const char* kReadoutMs = "readout_ms";
+}  // namespace camera_keys
+
+// The longest rolling-shutter readout accepted (SPEC §3), milliseconds.
+inline constexpr double kMaxReadoutMs = 1000.0;
+
 // The largest image ceilpose takes (configuration and recordings alike):
 // 8192 px a side and 32 Mpx, a 12 MP sensor with room to spare. The
 // pipeline's buffers are ~20 bytes a pixel; a recording.yaml saying

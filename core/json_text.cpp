@@ -3,6 +3,8 @@
 #include <cmath>
 #include <cstdio>
 
+#include "core/pose.h"
+
 namespace ceilpose {
 
 std::string json_quote(std::string_view text) {
@@ -42,6 +44,18 @@ double printable_yaw_rad(double yaw_rad, int decimals) {
   const double printed = std::round(yaw_rad * scale) / scale;
   if (printed > M_PI || printed <= -M_PI) return std::floor(M_PI * scale) / scale;
   return yaw_rad;
+}
+
+std::string pose_fields_json(const Pose2D* pose) {
+  if (pose == nullptr) return R"(,"x_m":null,"y_m":null,"yaw_rad":null)";
+  const auto number = [](double v) {
+    if (!std::isfinite(v)) return std::string("null");
+    char text[48];
+    std::snprintf(text, sizeof text, "%.7f", v);
+    return std::string(text);
+  };
+  return ",\"x_m\":" + number(pose->x_m) + ",\"y_m\":" + number(pose->y_m) +
+         ",\"yaw_rad\":" + number(printable_yaw_rad(pose->yaw_rad, 7));
 }
 
 }  // namespace ceilpose

@@ -15,4 +15,11 @@ std::string json_quote(std::string_view text);
 // (7 decimals), both outside. Those print as the largest decimal below π.
 double printable_yaw_rad(double yaw_rad, int decimals);
 
+struct Pose2D;
+// SPEC §5's pose fields, the one place their names are written:
+// ,"x_m":…,"y_m":…,"yaw_rad":… with 7 decimals (the yaw printable), or the
+// three as null without a pose. A non-finite number is null too: JSON has no
+// NaN. `locate`, `pose`/`watch` and `fleet` all print them through this.
+std::string pose_fields_json(const Pose2D* pose);
+
 }  // namespace ceilpose

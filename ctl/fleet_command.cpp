@@ -51,13 +51,11 @@ void print_json(const FleetArgs& args, const std::vector<FleetRobot>& robots, in
            ",\"encoding\":" + (r.xcdr1 ? "\"XCDR1\"" : "\"XCDR2\"") +
            ",\"samples\":" + std::to_string(r.samples);
     if (r.samples > 0) {
-      out += ",\"x_m\":" + json_number(r.latest.pose.x_m) +
-             ",\"y_m\":" + json_number(r.latest.pose.y_m) +
-             ",\"yaw_rad\":" + json_number(printable_yaw_rad(r.latest.pose.yaw_rad, 6)) +
+      out += pose_fields_json(&r.latest.pose) +
              ",\"stamp_ns\":" + std::to_string(r.latest.capture_realtime_ns) +
              ",\"age_ms\":" + std::to_string(age_ms(r, now_ns));
     } else {
-      out += R"(,"x_m":null,"y_m":null,"yaw_rad":null,"stamp_ns":null,"age_ms":null)";
+      out += pose_fields_json(nullptr) + R"(,"stamp_ns":null,"age_ms":null)";
     }
     out += "}";
   }

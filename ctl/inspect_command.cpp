@@ -148,18 +148,19 @@ void print_json(const RecordingReader& reader, const Summary& s) {
   field("duration_s", fixed(s.duration_s, 6));
   field("fps", s.fps > 0.0 ? fixed(s.fps, 3) : "null");
   field("size", "\"" + std::to_string(k.width) + "x" + std::to_string(k.height) + "\"");
-  field("width", std::to_string(k.width));
-  field("height", std::to_string(k.height));
-  field("fx", shortest(k.fx));
-  field("fy", shortest(k.fy));
-  field("cx", shortest(k.cx));
-  field("cy", shortest(k.cy));
+  namespace key = camera_keys;
+  field(key::kWidth, std::to_string(k.width));
+  field(key::kHeight, std::to_string(k.height));
+  field(key::kFx, shortest(k.fx));
+  field(key::kFy, shortest(k.fy));
+  field(key::kCx, shortest(k.cx));
+  field(key::kCy, shortest(k.cy));
   std::string distortion = "[";
   for (size_t c = 0; c < k.distortion.size(); ++c) {
     if (c > 0) distortion += ',';
     distortion += shortest(k.distortion[c]);
   }
-  field("distortion", distortion + "]");
+  field(key::kDistortion, distortion + "]");
   field("has_ground_truth", s.ground_truth_frames > 0 ? "true" : "false");
   field("ground_truth_frames", std::to_string(s.ground_truth_frames));
   field("png_frames", std::to_string(s.png_frames));

@@ -43,13 +43,12 @@ class JsonLinesSink final : public PoseSink {
           for (int c = 0; c < 3; ++c) cov[r * 3 + c] = motion.p[r * kMotionStates + c];
       }
       std::printf("{\"index\":%" PRId64 ",\"timestamp_ns\":%" PRId64
-                  ",\"valid\":true,\"x_m\":%.7f,\"y_m\":%.7f,\"yaw_rad\":%.7f,\"mode\":\"%.*s\","
-                  "\"markers\":%d,\"proc_us\":%" PRId64
+                  ",\"valid\":true%s"
+                  ",\"mode\":\"%.*s\",\"markers\":%d,\"proc_us\":%" PRId64
                   ",\"refusal\":null,\"rms_px\":%.3f,\"cov\":[%.3e,%.3e,%.3e,%.3e,%.3e,%.3e]",
-                  loc.frame.index, loc.frame.timestamp_ns, pose.x_m, pose.y_m,
-                  printable_yaw_rad(pose.yaw_rad, 7), static_cast<int>(mode.size()), mode.data(),
-                  e.markers, proc_us, e.rms_residual_px, cov[0], cov[1], cov[2], cov[4], cov[5],
-                  cov[8]);
+                  loc.frame.index, loc.frame.timestamp_ns, pose_fields_json(&pose).c_str(),
+                  static_cast<int>(mode.size()), mode.data(), e.markers, proc_us, e.rms_residual_px,
+                  cov[0], cov[1], cov[2], cov[4], cov[5], cov[8]);
       if (loc.motion.valid)
         std::printf(",\"vx_mps\":%.6f,\"vy_mps\":%.6f,\"yaw_rate_radps\":%.6f", motion.x[3],
                     motion.x[4], motion.x[5]);
@@ -58,11 +57,11 @@ class JsonLinesSink final : public PoseSink {
     } else {
       const std::string_view refusal = to_string(e.refusal);
       std::printf("{\"index\":%" PRId64 ",\"timestamp_ns\":%" PRId64
-                  ",\"valid\":false,\"x_m\":null,\"y_m\":null,\"yaw_rad\":null,\"mode\":\"%.*s\","
-                  "\"markers\":%d,\"proc_us\":%" PRId64 ",\"refusal\":\"%.*s\"",
-                  loc.frame.index, loc.frame.timestamp_ns, static_cast<int>(mode.size()),
-                  mode.data(), e.markers, proc_us, static_cast<int>(refusal.size()),
-                  refusal.data());
+                  ",\"valid\":false%s"
+                  ",\"mode\":\"%.*s\",\"markers\":%d,\"proc_us\":%" PRId64 ",\"refusal\":\"%.*s\"",
+                  loc.frame.index, loc.frame.timestamp_ns, pose_fields_json(nullptr).c_str(),
+                  static_cast<int>(mode.size()), mode.data(), e.markers, proc_us,
+                  static_cast<int>(refusal.size()), refusal.data());
       if (predict_ms_) std::printf(",\"predict_ms\":%.3f", *predict_ms_);
       std::fputs("}\n", stdout);
     }

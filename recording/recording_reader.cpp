@@ -139,7 +139,8 @@ Result<RecordingCamera> parse_yaml(const std::string& path) {
   }
   RecordingCamera out;
   CameraIntrinsics& k = out.intrinsics;
-  for (auto [key, dst] : {std::pair{"width", &k.width}, std::pair{"height", &k.height}}) {
+  namespace ck = camera_keys;
+  for (auto [key, dst] : {std::pair{ck::kWidth, &k.width}, std::pair{ck::kHeight, &k.height}}) {
     auto v = yaml_scalar<int>(cam, "camera", key, path, "a positive integer");
     if (!v) return v.error();
     if (*v <= 0 || *v > kMaxImageSidePx) {
@@ -150,21 +151,21 @@ Result<RecordingCamera> parse_yaml(const std::string& path) {
     *dst = *v;
   }
   if (static_cast<long>(k.width) * k.height > kMaxImagePixels) {
-    return make_error(path + ":" + std::to_string(line_of(cam["height"])) +
+    return make_error(path + ":" + std::to_string(line_of(cam[ck::kHeight])) +
                       ": camera.width x camera.height must be at most " +
                       std::to_string(kMaxImagePixels) + " pixels, got " + std::to_string(k.width) +
                       "x" + std::to_string(k.height));
   }
   for (auto [key, dst, positive] :
-       {std::tuple{"fx", &k.fx, true}, std::tuple{"fy", &k.fy, true},
-        std::tuple{"cx", &k.cx, false}, std::tuple{"cy", &k.cy, false}}) {
+       {std::tuple{ck::kFx, &k.fx, true}, std::tuple{ck::kFy, &k.fy, true},
+        std::tuple{ck::kCx, &k.cx, false}, std::tuple{ck::kCy, &k.cy, false}}) {
     auto v = yaml_camera_number(cam, key, path, positive);
     if (!v) return v.error();
     *dst = *v;
   }
   // distortion is optional (absent means none), but when present it is
   // exactly the five plumb_bob coefficients.
-  const YAML::Node dist = cam["distortion"];
+  const YAML::Node dist = cam[ck::kDistortion];
   if (dist.IsDefined() && !dist.IsNull()) {
     if (!dist.IsSequence() || dist.size() != fmt::kDistortionCoefficients) {
       return make_error(
@@ -184,12 +185,13 @@ Result<RecordingCamera> parse_yaml(const std::string& path) {
                         ": camera.distortion: " + lens);
   }
   // readout_ms is optional (SPEC §3: absent means a global shutter).
-  if (const YAML::Node readout = cam["readout_ms"]; readout.IsDefined() && !readout.IsNull()) {
-    auto v = yaml_scalar<double>(cam, "camera", "readout_ms", path, "a number of milliseconds");
+  if (const YAML::Node readout = cam[ck::kReadoutMs]; readout.IsDefined() && !readout.IsNull()) {
+    auto v = yaml_scalar<double>(cam, "camera", ck::kReadoutMs, path, "a number of milliseconds");
     if (!v) return v.error();
-    if (!std::isfinite(*v) || *v < 0.0 || *v > 1000.0) {
-      return make_error(path + ":" + std::to_string(line_of(readout)) +
-                        ": key 'camera.readout_ms' must be 0 to 1000 ms");
+    if (!std::isfinite(*v) || *v < 0.0 || *v > kMaxReadoutMs) {
+      return make_error(path + ":" + std::to_string(line_of(readout)) + ": key 'camera." +
+                        ck::kReadoutMs + "' must be 0 to " +
+                        std::to_string(static_cast<int>(kMaxReadoutMs)) + " ms");
     }
     k.readout_ms = *v;
   }
@@ -271,9 +273,10 @@ struct Columns {
 Result<Columns> parse_header(const std::vector<std::string>& names, const std::string& where) {
   Columns c;
   c.count = names.size();
-  const std::pair<const char*, int*> known[] = {{"index", &c.index}, {"timestamp_ns", &c.timestamp},
-                                                {"file", &c.file},   {"gt_x_m", &c.gt_x},
-                                                {"gt_y_m", &c.gt_y}, {"gt_yaw_rad", &c.gt_yaw}};
+  const std::pair<const char*, int*> known[] = {
+      {fmt::kColIndex, &c.index}, {fmt::kColTimestamp, &c.timestamp},
+      {fmt::kColFile, &c.file},   {fmt::kColGtX, &c.gt_x},
+      {fmt::kColGtY, &c.gt_y},    {fmt::kColGtYaw, &c.gt_yaw}};
   for (size_t i = 0; i < names.size(); ++i) {
     for (const auto& [name, slot] : known) {
       if (names[i] != name) continue;
@@ -285,14 +288,14 @@ Result<Columns> parse_header(const std::vector<std::string>& names, const std::s
   }
   for (const auto& [name, slot] : {known[0], known[1], known[2]}) {
     if (*slot < 0) {
-      return make_error(where + ":1: header lacks the required column '" + name +
-                        "' (need index,timestamp_ns,file)");
+      return make_error(where + ":1: header lacks the required column '" + name + "' (need " +
+                        fmt::kColIndex + "," + fmt::kColTimestamp + "," + fmt::kColFile + ")");
     }
   }
   const int gt = (c.gt_x >= 0) + (c.gt_y >= 0) + (c.gt_yaw >= 0);
   if (gt != 0 && gt != 3) {
-    return make_error(where +
-                      ":1: ground truth needs all three columns gt_x_m, gt_y_m, gt_yaw_rad");
+    return make_error(where + ":1: ground truth needs all three columns " + fmt::kColGtX + ", " +
+                      fmt::kColGtY + ", " + fmt::kColGtYaw);
   }
   return c;
 }

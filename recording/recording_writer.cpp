@@ -60,19 +60,21 @@ std::string yaml_text(const RecordingCamera& camera) {
   y += std::string("format: ") + fmt::kFormat + "\n";
   y += "version: " + std::to_string(fmt::kVersion) + "\n";
   y += "camera:\n";
-  y += "  width: " + std::to_string(k.width) + "\n";
-  y += "  height: " + std::to_string(k.height) + "\n";
-  y += "  fx: " + number_text(k.fx) + "\n";
-  y += "  fy: " + number_text(k.fy) + "\n";
-  y += "  cx: " + number_text(k.cx) + "\n";
-  y += "  cy: " + number_text(k.cy) + "\n";
-  y += "  distortion: [";
+  namespace key = camera_keys;
+  y += std::string("  ") + key::kWidth + ": " + std::to_string(k.width) + "\n";
+  y += std::string("  ") + key::kHeight + ": " + std::to_string(k.height) + "\n";
+  y += std::string("  ") + key::kFx + ": " + number_text(k.fx) + "\n";
+  y += std::string("  ") + key::kFy + ": " + number_text(k.fy) + "\n";
+  y += std::string("  ") + key::kCx + ": " + number_text(k.cx) + "\n";
+  y += std::string("  ") + key::kCy + ": " + number_text(k.cy) + "\n";
+  y += std::string("  ") + key::kDistortion + ": [";
   for (size_t c = 0; c < k.distortion.size(); ++c) {
     if (c > 0) y += ", ";
     y += number_text(k.distortion[c]);
   }
   y += "]   # k1 k2 p1 p2 k3\n";
-  y += "  readout_ms: " + number_text(k.readout_ms) + "   # rolling-shutter readout, 0 = global\n";
+  y += std::string("  ") + key::kReadoutMs + ": " + number_text(k.readout_ms) +
+       "   # rolling-shutter readout, 0 = global\n";
   if (!camera.source.empty()) y += "source: " + yaml_quoted(camera.source) + "\n";
   return y;
 }
@@ -270,9 +272,7 @@ Result<void> RecordingWriter::append(const ImageView& frame, int64_t timestamp_n
   char* p = row.data();
   if (s.frames == 0) {
     s.ground_truth_columns = gt_columns;
-    const std::string_view header = gt_columns
-                                        ? "index,timestamp_ns,file,gt_x_m,gt_y_m,gt_yaw_rad\n"
-                                        : "index,timestamp_ns,file\n";
+    const std::string_view header = gt_columns ? fmt::kHeaderWithTruth : fmt::kHeader;
     p = std::copy(header.begin(), header.end(), p);
   }
   char* const end = row.data() + row.size() - 1;
@@ -303,8 +303,7 @@ Result<void> RecordingWriter::close() {
   s.closed = true;
   const std::string csv_path = s.dir + "/" + fmt::kCsvName;
   if (s.frames == 0 && s.csv_bytes == 0) {
-    constexpr std::string_view kHeader = "index,timestamp_ns,file\n";
-    if (auto ok = append_lines(kHeader.data(), kHeader.size()); !ok) return ok;
+    if (auto ok = append_lines(fmt::kHeader.data(), fmt::kHeader.size()); !ok) return ok;
   }
   // On disk before the command says it is done: frames.csv, and with
   // syncfs the frame files and directory entries too (one call, not one

@@ -28,12 +28,8 @@ double degrees(double rad) { return rad * 180.0 / std::numbers::pi; }
 std::string pose_json(const PoseRecord& p, int64_t now_mono_ns, const std::string& extra) {
   const bool valid = pose_is_valid(p);
   std::string out = format("{\"seq\":%" PRIu64 ",\"valid\":%s", p.seq, valid ? "true" : "false");
-  if (valid) {
-    out += format(",\"x_m\":%.7f,\"y_m\":%.7f,\"yaw_rad\":%.7f", p.x_m, p.y_m,
-                  printable_yaw_rad(p.yaw_rad, 7));
-  } else {
-    out += ",\"x_m\":null,\"y_m\":null,\"yaw_rad\":null";
-  }
+  const Pose2D pose{p.x_m, p.y_m, p.yaw_rad};
+  out += pose_fields_json(valid ? &pose : nullptr);
   out += format(",\"mode\":\"%s\",\"markers\":%u,\"timestamp_ns\":%" PRId64
                 ",\"capture_real_ns\":%" PRId64 ",\"publish_real_ns\":%" PRId64
                 ",\"age_ms\":%.3f,\"filtered\":%s,\"coasting\":%s",
@@ -60,9 +56,8 @@ std::string pose_json(const PoseRecord& p, int64_t now_mono_ns, const std::strin
 }
 
 std::string no_pose_json(const std::string& extra) {
-  return "{\"seq\":null,\"valid\":false,\"x_m\":null,\"y_m\":null,\"yaw_rad\":null,\"mode\":null,"
-         "\"markers\":null,\"timestamp_ns\":null" +
-         extra + "}";
+  return "{\"seq\":null,\"valid\":false" + pose_fields_json(nullptr) +
+         ",\"mode\":null,\"markers\":null,\"timestamp_ns\":null" + extra + "}";
 }
 
 std::string pose_line(const PoseRecord& p, int64_t now_mono_ns) {

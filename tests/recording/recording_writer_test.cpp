@@ -12,6 +12,7 @@
 #include <opencv2/imgcodecs.hpp>
 #include <optional>
 
+#include "recording/recording_format.h"
 #include "recording/recording_reader.h"
 #include "tests/recording/recording_test_support.h"
 
@@ -271,6 +272,17 @@ TEST_F(RecordingWriterTest, WritesStridedViews) {
               0)
         << "row " << y;
   }
+}
+
+// SPEC §4's column names are written once (recording_format.h); the header
+// lines the writer writes are made of them, in order.
+TEST(RecordingFormat, TheHeaderLinesAreTheColumnNames) {
+  namespace f = recording_format;
+  const std::string required =
+      std::string(f::kColIndex) + "," + f::kColTimestamp + "," + f::kColFile;
+  EXPECT_EQ(f::kHeader, required + "\n");
+  EXPECT_EQ(f::kHeaderWithTruth,
+            required + "," + f::kColGtX + "," + f::kColGtY + "," + f::kColGtYaw + "\n");
 }
 
 }  // namespace
