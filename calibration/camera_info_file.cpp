@@ -84,7 +84,9 @@ Result<CameraIntrinsics> read_camera_info_file(const std::string& path) {
   k.fy = m[4];
   k.cy = m[5];
   const YAML::Node model = (*root)["distortion_model"];
-  if (model.IsDefined() && !(model.IsScalar() && model.Scalar() == "plumb_bob")) {
+  if (!model.IsDefined() || model.IsNull())
+    return make_error(where(path, *root) + ": missing key 'distortion_model' (plumb_bob)");
+  if (!(model.IsScalar() && model.Scalar() == "plumb_bob")) {
     return make_error(where(path, model) + ": distortion_model '" +
                       (model.IsScalar() ? model.Scalar() : std::string("?")) +
                       "' is not supported (ceilpose's camera model is plumb_bob, SPEC §3)");
@@ -95,6 +97,24 @@ Result<CameraIntrinsics> read_camera_info_file(const std::string& path) {
   if (const std::string lens = distortion_problem(k); !lens.empty())
     return make_error(where(path, (*root)["distortion_coefficients"]) +
                       ": distortion_coefficients: " + lens);
+  // ROS writes both; ceilpose uses neither, but a file that carries them
+  // malformed, or a rectification it would silently ignore, is not a
+  // calibration to trust.
+  if ((*root)["rectification_matrix"].IsDefined()) {
+    auto r = matrix(path, *root, "rectification_matrix", 3, 3);
+    if (!r) return r.error();
+    for (size_t c = 0; c < 9; ++c) {
+      if (std::abs((*r)[c] - (c % 4 == 0 ? 1.0 : 0.0)) > 1e-9) {
+        return make_error(where(path, (*root)["rectification_matrix"]) +
+                          ": rectification_matrix must be the identity: ceilpose does not "
+                          "rectify (a stereo camera's rectified calibration?)");
+      }
+    }
+  }
+  if ((*root)["projection_matrix"].IsDefined()) {
+    auto pm = matrix(path, *root, "projection_matrix", 3, 4);
+    if (!pm) return pm.error();
+  }
   return k;
 }
 

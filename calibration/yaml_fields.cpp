@@ -2,6 +2,7 @@
 
 #include <cmath>
 #include <cstring>
+#include <type_traits>
 
 #include "core/text_file.h"
 #include "core/yaml_duplicate_keys.h"
@@ -40,9 +41,15 @@ Result<T> scalar(const std::string& path, const YAML::Node& parent, const char* 
     return make_error(where(path, parent) + ": missing key '" + key_path + "'");
   }
   T value{};
-  if (!node.IsScalar() || !YAML::convert<T>::decode(node, value)) {
+  // A quoted scalar ("640") is text, however it reads: a number the file
+  // wrote as a string is a mistake to name, not a value to guess.
+  const bool quoted_number = std::is_arithmetic_v<T> && node.IsScalar() && node.Tag() == "!";
+  if (!node.IsScalar() || quoted_number || !YAML::convert<T>::decode(node, value)) {
     return make_error(where(path, node) + ": key '" + key_path + "' must be " + expected +
-                      (node.IsScalar() ? ", found '" + node.Scalar() + "'" : ""));
+                      (node.IsScalar()
+                           ? std::string(quoted_number ? ", found the string '" : ", found '") +
+                                 node.Scalar() + "'"
+                           : std::string()));
   }
   return value;
 }

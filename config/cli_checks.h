@@ -51,4 +51,32 @@ inline CLI::Validator count() {
       "N >= 0");
 }
 
+// A finite number: CLI11's Range and PositiveNumber compare, and NaN passes
+// every comparison.
+inline CLI::Validator finite_number() {
+  return CLI::Validator(
+      [](const std::string& value) {
+        double v = 0.0;
+        try {
+          size_t used = 0;
+          v = std::stod(value, &used);
+          if (used != value.size()) return std::string();  // not a number: CLI11 says so
+        } catch (const std::exception&) {
+          return std::string();
+        }
+        return std::isfinite(v) ? std::string() : "must be a finite number, got '" + value + "'";
+      },
+      "FINITE");
+}
+
+// Every floating-point option of `app` and of its sub-commands refuses nan
+// and inf (a usage error, exit 2), so no option can forget it. Call after
+// every option is added.
+inline void refuse_non_finite_numbers(CLI::App& app) {
+  for (CLI::Option* option : app.get_options())
+    if (option->get_type_name().rfind("FLOAT", 0) == 0) option->check(finite_number());
+  for (CLI::App* sub : app.get_subcommands([](CLI::App*) { return true; }))
+    refuse_non_finite_numbers(*sub);
+}
+
 }  // namespace ceilpose::cli

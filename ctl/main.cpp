@@ -6,6 +6,7 @@
 #include <cstring>
 #include <iostream>
 
+#include "config/cli_checks.h"
 #include "ctl/command_registry.h"
 
 namespace {
@@ -33,6 +34,7 @@ int main(int argc, char** argv) {
   std::sort(commands.begin(), commands.end(),
             [](const RegisteredCommand& a, const RegisteredCommand& b) { return a.name < b.name; });
   for (const auto& c : commands) c.factory(app);
+  cli::refuse_non_finite_numbers(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

@@ -3,11 +3,15 @@
 #include <sys/stat.h>
 
 #include <cerrno>
+#include <charconv>
 #include <cstdio>
 #include <cstring>
+#include <filesystem>
 #include <memory>
 #include <sstream>
 #include <string>
+#include <string_view>
+#include <system_error>
 #include <vector>
 
 #include "config/service_config.h"
@@ -34,16 +38,31 @@ bool parse_codes(const std::string& text, int codes, std::vector<std::array<int,
     return true;
   }
   std::stringstream list(text);
+  // Each side read whole and range-checked as it is: sscanf's %d wrapped
+  // 4294967299 to 3 and printed marker_3_5.
+  const auto code_of = [codes](std::string_view text, int* value) {
+    while (!text.empty() && text.front() == ' ') text.remove_prefix(1);
+    while (!text.empty() && text.back() == ' ') text.remove_suffix(1);
+    long long v = -1;
+    const auto [end, ec] = std::from_chars(text.data(), text.data() + text.size(), v);
+    if (ec == std::errc::result_out_of_range)
+      v = -1;
+    else if (ec != std::errc{} || end != text.data() + text.size() || text.empty())
+      return false;
+    *value = v >= 0 && v < codes ? static_cast<int>(v) : -1;
+    return true;
+  };
   for (std::string item; std::getline(list, item, ';');) {
+    const size_t comma = item.find(',');
     int i = -1, j = -1;
-    char tail = 0;
-    if (std::sscanf(item.c_str(), " %d , %d %c", &i, &j, &tail) != 2) {
+    if (comma == std::string::npos || !code_of(std::string_view(item).substr(0, comma), &i) ||
+        !code_of(std::string_view(item).substr(comma + 1), &j)) {
       *error = "--codes: '" + item + "' is not I,J (e.g. 3,5;0,7 or all)";
       return false;
     }
-    if (i < 0 || j < 0 || i >= codes || j >= codes) {
-      *error = "--codes: (" + std::to_string(i) + ", " + std::to_string(j) +
-               ") is outside the ceiling's 0.." + std::to_string(codes - 1) + " codes";
+    if (i < 0 || j < 0) {
+      *error = "--codes: '" + item + "' is outside the ceiling's 0.." + std::to_string(codes - 1) +
+               " codes";
       return false;
     }
     out->push_back({i, j});
@@ -72,9 +91,12 @@ void run_markers(const MarkersArgs& args) {
     std::fprintf(stderr, "ceilposectl markers: %s\n", error.c_str());
     return set_exit_code(kExitUsage);
   }
-  if (::mkdir(args.out_dir.c_str(), 0755) != 0 && errno != EEXIST) {
+  // "Created if missing", parents included (markers --out a/b/c).
+  std::error_code made;
+  std::filesystem::create_directories(args.out_dir, made);
+  if (made) {
     std::fprintf(stderr, "ceilposectl markers: %s: cannot create: %s\n", args.out_dir.c_str(),
-                 std::strerror(errno));
+                 made.message().c_str());
     return set_exit_code(kExitFailure);
   }
   const SheetFormat format = args.format == "pdf" ? SheetFormat::kPdf : SheetFormat::kSvg;

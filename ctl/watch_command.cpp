@@ -71,6 +71,21 @@ int run_watch(const WatchArgs& args) {
         std::this_thread::sleep_for(std::chrono::milliseconds(1));
         continue;
       }
+      // The first pose after attaching is the segment's latest, however old:
+      // a stopped, dead or stale daemon's last pose is not a pose to print
+      // as current (issue 28: watch --count 1 printed a killed daemon's pose,
+      // valid, 6 s old, and exited 0). Say so and wait for a live one.
+      if (last_seq == 0) {
+        const Liveness now = reader.liveness(args.stale_ms);
+        if (now == Liveness::kStopped || now == Liveness::kWriterDead || now == Liveness::kStale) {
+          note("daemon (pid " + std::to_string(reader.writer_info().pid) + ") on " + args.shm +
+               " is " + std::string(to_string(now)) + "; its last pose (seq " +
+               std::to_string(pose.seq) + ") is not shown; waiting");
+          reported = to_string(now);
+          last_seq = pose.seq;
+          continue;
+        }
+      }
       if (last_seq != 0 && pose.seq < last_seq) {
         note("pose sequence on " + args.shm + " went back from " + std::to_string(last_seq) +
              " to " + std::to_string(pose.seq) +

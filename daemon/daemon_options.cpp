@@ -61,6 +61,7 @@ bool parse_command_line(int argc, char** argv, DaemonOptions* options, int* exit
   app.add_flag("--print-config", options->print_config,
                "print the effective configuration (file + options) as YAML and exit");
 
+  cli::refuse_non_finite_numbers(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

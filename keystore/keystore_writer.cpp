@@ -43,10 +43,15 @@ Result<void> check_validity(const Validity& v) {
 Result<void> init_keystore(const std::string& dir, const Validity& validity) {
   if (auto ok = check_validity(validity); !ok) return ok;
   const KeystoreLayout ks{dir};
-  if (exists(ks.ca_certificate())) {
-    return make_error("keystore " + dir + " already has a CA (" + ks.ca_certificate() +
-                      "): a new CA would disown every enclave the old one signed; use "
-                      "'keys add' to add robots, or another directory");
+  // Any of the CA's files: a certificate alone, or a key whose certificate
+  // was moved away, is still the CA every enclave was signed by.
+  for (const std::string& ca_file :
+       {ks.ca_certificate(), ks.ca_private_key(), ks.governance_p7s()}) {
+    if (exists(ca_file)) {
+      return make_error("keystore " + dir + " already has a CA (" + ca_file +
+                        "): a new CA would disown every enclave the old one signed; use "
+                        "'keys add' to add robots, or another directory");
+    }
   }
   for (const auto& [path, mode] :
        {std::pair{dir, kPublicDirMode}, std::pair{dir + "/public", kPublicDirMode},

@@ -63,10 +63,6 @@ struct NominalPrior {
   }
 };
 
-// Image points' noise assumed for the first solve, px; the second uses the
-// residuals' own.
-constexpr double kFirstPixelSigma = 0.25;
-
 struct Sighting {
   int frame;
   int marker;  // index into the frame's markers
@@ -413,7 +409,7 @@ Result<SurveyReport> survey_ceiling(const PipelineConfig& config,
     frame_used[static_cast<size_t>(s.frame)] = true;
   }
   std::vector<int> mapped;
-  double pixel_sigma = kFirstPixelSigma;
+  double pixel_sigma = options.first_pixel_sigma_px;
   for (int code = 0; code < codes * codes; ++code) {
     if (frames_of[static_cast<size_t>(code)] < options.min_frames) continue;
     mapped.push_back(code);

@@ -31,7 +31,11 @@ struct SurveyOptions {
   double prior_sigma_m = 0.05;          // marker centre about its nominal spot, 1-sigma
   double prior_sigma_yaw_rad = 0.0873;  // marker rotation about nominal, 1-sigma (5°)
   double robust_px = 1.0;               // Huber threshold on a point's residual, px
-  int min_frames = 3;                   // a marker is mapped when decoded in this many frames
+  // Image points' noise assumed for the first solve, px, weighing the
+  // markers' priors against the points; the second solve uses the
+  // residuals' own. Only the first solve's starting balance depends on it.
+  double first_pixel_sigma_px = 0.25;
+  int min_frames = 3;  // a marker is mapped when decoded in this many frames
   // A sighting farther than this from the marker's nominal spot is of
   // another marker printed with the same code.
   double duplicate_distance_m = 0.2;

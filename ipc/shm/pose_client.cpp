@@ -16,14 +16,26 @@ struct ceilpose_client {
 
 namespace {
 
-thread_local std::string g_last_error;
+// What ceilpose_last_error_message() returns: the last call's, on this
+// thread. Every call sets it, so an earlier failure never outlives a later
+// call; a per-frame call only points it at a static text (no allocation).
+thread_local std::string g_last_detail;
+thread_local const char* g_last_message = "";
 
+// A failure whose message names what failed (open, reattach).
 int set_error(int code, const char* detail) {
   try {
-    g_last_error = detail;
+    g_last_detail = detail;
+    g_last_message = g_last_detail.c_str();
   } catch (...) {
-    g_last_error.clear();
+    g_last_message = ceilpose_strerror(code);
   }
+  return code;
+}
+
+// The outcome of any other call: "" on success, else the code's text.
+int outcome(int code) {
+  g_last_message = code == CEILPOSE_OK ? "" : ceilpose_strerror(code);
   return code;
 }
 
@@ -68,7 +80,7 @@ int ceilpose_client_open(const char* name, ceilpose_client** out) {
         ceilpose::ShmPoseReader::open(name != nullptr ? name : CEILPOSE_DEFAULT_SHM_NAME, &code);
     if (!reader) return set_error(static_cast<int>(code), reader.error().message.c_str());
     *out = new ceilpose_client{std::move(reader.value())};
-    return CEILPOSE_OK;
+    return outcome(CEILPOSE_OK);
   } catch (const std::bad_alloc&) {
     return set_error(CEILPOSE_ERR_NO_MEMORY, "out of memory opening the pose segment");
   } catch (...) {
@@ -79,36 +91,36 @@ int ceilpose_client_open(const char* name, ceilpose_client** out) {
 void ceilpose_client_close(ceilpose_client* client) { delete client; }
 
 int ceilpose_client_read_latest(ceilpose_client* client, ceilpose_pose* out) {
-  if (client == nullptr || out == nullptr) return CEILPOSE_ERR_INVALID_ARGUMENT;
-  return read_code(client->reader.read_latest(out));
+  if (client == nullptr || out == nullptr) return outcome(CEILPOSE_ERR_INVALID_ARGUMENT);
+  return outcome(read_code(client->reader.read_latest(out)));
 }
 
 int ceilpose_client_wait_next(ceilpose_client* client, uint64_t after_seq, int32_t timeout_ms,
                               ceilpose_pose* out) {
-  if (client == nullptr || out == nullptr) return CEILPOSE_ERR_INVALID_ARGUMENT;
-  return wait_code(client->reader.wait_next(after_seq, timeout_ms, out));
+  if (client == nullptr || out == nullptr) return outcome(CEILPOSE_ERR_INVALID_ARGUMENT);
+  return outcome(wait_code(client->reader.wait_next(after_seq, timeout_ms, out)));
 }
 
 int ceilpose_client_predict(ceilpose_client* client, int64_t t_mono_ns, ceilpose_pose* out) {
-  if (client == nullptr || out == nullptr) return CEILPOSE_ERR_INVALID_ARGUMENT;
+  if (client == nullptr || out == nullptr) return outcome(CEILPOSE_ERR_INVALID_ARGUMENT);
   ceilpose_pose latest;
   const int rc = read_code(client->reader.read_latest(&latest));
-  if (rc != CEILPOSE_OK) return rc;
+  if (rc != CEILPOSE_OK) return outcome(rc);
   switch (ceilpose::predict_pose(latest, t_mono_ns, out)) {
     case ceilpose::PredictResult::kOk:
-      return CEILPOSE_OK;
+      return outcome(CEILPOSE_OK);
     case ceilpose::PredictResult::kNoMotion:
-      return CEILPOSE_ERR_NO_MOTION;
+      return outcome(CEILPOSE_ERR_NO_MOTION);
     case ceilpose::PredictResult::kBeyondHorizon:
-      return CEILPOSE_ERR_HORIZON;
+      return outcome(CEILPOSE_ERR_HORIZON);
   }
-  return CEILPOSE_ERR_SYSTEM;
+  return outcome(CEILPOSE_ERR_SYSTEM);
 }
 
 int ceilpose_client_liveness(ceilpose_client* client, int64_t stale_after_ms,
                              enum ceilpose_liveness* out) {
   if (client == nullptr || out == nullptr || stale_after_ms < 0) {
-    return CEILPOSE_ERR_INVALID_ARGUMENT;
+    return outcome(CEILPOSE_ERR_INVALID_ARGUMENT);
   }
   switch (client->reader.liveness(stale_after_ms)) {
     case ceilpose::Liveness::kLive:
@@ -130,16 +142,16 @@ int ceilpose_client_liveness(ceilpose_client* client, int64_t stale_after_ms,
       *out = CEILPOSE_RESTARTED;
       break;
   }
-  return CEILPOSE_OK;
+  return outcome(CEILPOSE_OK);
 }
 
 int ceilpose_client_reattach(ceilpose_client* client) {
-  if (client == nullptr) return CEILPOSE_ERR_INVALID_ARGUMENT;
+  if (client == nullptr) return outcome(CEILPOSE_ERR_INVALID_ARGUMENT);
   try {
     ceilpose::shm::ShmErrc code = ceilpose::shm::ShmErrc::kOk;
     auto r = client->reader.reattach(&code);
     if (!r) return set_error(static_cast<int>(code), r.error().message.c_str());
-    return CEILPOSE_OK;
+    return outcome(CEILPOSE_OK);
   } catch (const std::bad_alloc&) {
     return set_error(CEILPOSE_ERR_NO_MEMORY, "out of memory re-opening the pose segment");
   } catch (...) {
@@ -148,12 +160,12 @@ int ceilpose_client_reattach(ceilpose_client* client) {
 }
 
 int ceilpose_client_read_status(ceilpose_client* client, ceilpose_status* out) {
-  if (client == nullptr || out == nullptr) return CEILPOSE_ERR_INVALID_ARGUMENT;
-  return read_code(client->reader.read_status(out));
+  if (client == nullptr || out == nullptr) return outcome(CEILPOSE_ERR_INVALID_ARGUMENT);
+  return outcome(read_code(client->reader.read_status(out)));
 }
 
 int ceilpose_client_writer_info(ceilpose_client* client, ceilpose_writer_info* out) {
-  if (client == nullptr || out == nullptr) return CEILPOSE_ERR_INVALID_ARGUMENT;
+  if (client == nullptr || out == nullptr) return outcome(CEILPOSE_ERR_INVALID_ARGUMENT);
   const ceilpose::WriterInfo info = client->reader.writer_info();
   out->pid = info.pid;
   out->state = static_cast<uint32_t>(info.state);
@@ -162,18 +174,18 @@ int ceilpose_client_writer_info(ceilpose_client* client, ceilpose_writer_info* o
   out->start_real_ns = info.start_real_ns;
   out->heartbeat_mono_ns = info.heartbeat_mono_ns;
   out->stale_after_ms = static_cast<uint32_t>(info.stale_after_ms);
-  return CEILPOSE_OK;
+  return outcome(CEILPOSE_OK);
 }
 
 int ceilpose_client_read_recent(ceilpose_client* client, ceilpose_pose* out, uint32_t max_poses,
                                 uint32_t* count) {
   if (client == nullptr || out == nullptr || count == nullptr) {
-    return CEILPOSE_ERR_INVALID_ARGUMENT;
+    return outcome(CEILPOSE_ERR_INVALID_ARGUMENT);
   }
   const int limit = max_poses > CEILPOSE_POSE_RING_LENGTH ? CEILPOSE_POSE_RING_LENGTH
                                                           : static_cast<int>(max_poses);
   *count = static_cast<uint32_t>(client->reader.read_recent(out, limit));
-  return CEILPOSE_OK;
+  return outcome(CEILPOSE_OK);
 }
 
 const char* ceilpose_mode_name(uint8_t mode) { return ceilpose::pose_mode_name(mode); }
@@ -228,6 +240,6 @@ const char* ceilpose_strerror(int code) {
   }
 }
 
-const char* ceilpose_last_error_message(void) { return g_last_error.c_str(); }
+const char* ceilpose_last_error_message(void) { return g_last_message; }
 
 }  // extern "C"

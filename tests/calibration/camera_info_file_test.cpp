@@ -88,7 +88,19 @@ INSTANTIATE_TEST_SUITE_P(
         // Found by fuzz_camera_info: a matrix without `data` threw out of the
         // reader (yaml-cpp's InvalidNode) and ended the process.
         BadInfo{"NoData", replaced("data: [-0.08", "dAta: [-0.08"),
-                "'distortion_coefficients' must be a 1 x 5 matrix"}),
+                "'distortion_coefficients' must be a 1 x 5 matrix"},
+        // Issue 28, defect 17: each of these was accepted silently.
+        BadInfo{"NoModel", replaced("distortion_model: plumb_bob\n", ""),
+                "missing key 'distortion_model'"},
+        BadInfo{"QuotedWidth", replaced("image_width: 640", "image_width: \"640\""),
+                "key 'image_width' must be an integer, found the string '640'"},
+        BadInfo{"RotatedRectification",
+                replaced("data: [1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0]",
+                         "data: [0.0, -1.0, 0.0, 1.0, 0.0, 0.0, 0.0, 0.0, 1.0]"),
+                "rectification_matrix must be the identity"},
+        BadInfo{"ProjectionOfThreeValues",
+                replaced("rows: 3, cols: 4, data: [", "rows: 1, cols: 3, data: ["),
+                "'projection_matrix' must be a 3 x 4 matrix"}),
     [](const auto& info) { return std::string(info.param.name); });
 
 TEST(CalibrationFiles, ACameraOfAnotherSizeIsAnErrorNotARescale) {

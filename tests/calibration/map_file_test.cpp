@@ -92,6 +92,9 @@ INSTANTIATE_TEST_SUITE_P(
                ":1: format 'ceilpose-recording' is not 'ceilpose-map'"},
         BadMap{"Version", "format: ceilpose-map\nversion: 2\nmarkers:\n" + kOne,
                ":2: unsupported version 2"},
+        // Issue 28, defect 17: a quoted version was read as the number.
+        BadMap{"QuotedVersion", "format: ceilpose-map\nversion: \"1\"\nmarkers:\n" + kOne,
+               "must be an integer, found the string '1'"},
         BadMap{"Twice", std::string(kHeader) + kOne + kOne,
                ":11: markers[1] (code [1, 2]): code listed twice"},
         // Found by fuzz_map: yaml-cpp threw for the missing key (a crash).

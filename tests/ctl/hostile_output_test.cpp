@@ -5,17 +5,17 @@
 #include <gtest/gtest.h>
 #include <unistd.h>
 
+#include <cstdlib>
+#include <filesystem>
 #include <string>
 #include <vector>
 
+#include "core/exit_codes.h"
 #include "tests/ctl/run_ceilposectl.h"
 #include "tests/recording/recording_test_support.h"
 
 namespace ceilpose::test {
 namespace {
-
-constexpr int kExitFailure = 1;
-constexpr int kExitUsage = 2;
 
 class HostileOutput : public ::testing::Test {
  protected:
@@ -68,6 +68,43 @@ TEST_F(HostileOutput, CountsAndDurationsThatNeverEndAreUsageErrors) {
   EXPECT_NE(fleet.err.find("--duration: must be a number of seconds above 0, got 'nan'"),
             std::string::npos)
       << fleet.err;
+}
+
+// Issue 28, defect 8: CLI11's ranges compare, and NaN passes every
+// comparison; `record --duration nan` recorded forever, `render --readout-ms
+// nan` wrote a recording its own reader rejects. Every floating-point option
+// of every sub-command now refuses nan and inf.
+TEST_F(HostileOutput, NotANumberOrInfinityIsAUsageErrorInEveryNumericOption) {
+  const std::vector<std::vector<std::string>> cases = {
+      {"survey", "--prior-sigma-mm", "nan", "--replay", "/nonexistent", "--out", "/tmp/m.yaml"},
+      {"render", "--readout-ms", "nan", "--out", "/tmp/ceilpose-nan-render"},
+      {"record", "--duration", "inf", "--out", "/tmp/ceilpose-nan-rec", "--source", "synthetic"},
+      {"locate", "--predict-ms", "-inf", "--replay", "/nonexistent"},
+      {"fleet", "--duration", "nan"}};
+  for (const auto& args : cases) {
+    const CommandOutput r = run_ceilposectl(args);
+    EXPECT_EQ(r.exit_code, kExitUsage) << args[0] << ": " << r.err;
+    EXPECT_NE(r.err.find(args[1] + ": "), std::string::npos) << args[0] << ": " << r.err;
+  }
+}
+
+// Issue 28, defect 20: `--codes 4294967299,5` wrapped to 3 and wrote
+// marker_3_5.svg; `--out a/b/c` failed although the help says "created if
+// missing".
+TEST_F(HostileOutput, MarkerCodesAreReadWholeAndTheOutputDirectoryIsMadeWithItsParents) {
+  const CommandOutput wrapped =
+      run_ceilposectl({"markers", "--out", "/tmp/ceilpose-wrap", "--codes", "4294967299,5"});
+  EXPECT_EQ(wrapped.exit_code, kExitUsage) << wrapped.err;
+  EXPECT_NE(wrapped.err.find("'4294967299,5' is outside the ceiling's 0..7 codes"),
+            std::string::npos)
+      << wrapped.err;
+  char tmpl[] = "/tmp/ceilpose-markers-XXXXXX";
+  ASSERT_NE(::mkdtemp(tmpl), nullptr);
+  const std::string nested = std::string(tmpl) + "/a/b/c";
+  const CommandOutput made = run_ceilposectl({"markers", "--out", nested, "--codes", "1,2"});
+  EXPECT_EQ(made.exit_code, kExitOk) << made.err;
+  EXPECT_TRUE(std::filesystem::exists(nested + "/marker_1_2.svg")) << made.err;
+  std::filesystem::remove_all(tmpl);
 }
 
 // A malformed --shm used to exit 1 (a runtime failure) from the reader.

@@ -2,14 +2,12 @@
 // malformed recordings: exit status and what they say on stderr.
 #include <gtest/gtest.h>
 
+#include "core/exit_codes.h"
 #include "tests/ctl/run_ceilposectl.h"
 #include "tests/recording/recording_test_support.h"
 
 namespace ceilpose::test {
 namespace {
-
-constexpr int kExitUsage = 2;
-constexpr int kExitBadInput = 4;
 
 class InspectCommand : public ::testing::Test {
  protected:

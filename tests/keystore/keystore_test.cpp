@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 #include <sys/stat.h>
 
+#include <cstdio>
 #include <ctime>
 #include <filesystem>
 #include <fstream>
@@ -120,6 +121,19 @@ TEST_F(KeystoreTest, InitRefusesAKeystoreThatHasACa) {
             std::string::npos)
       << again.error().message;
   EXPECT_EQ(slurp(layout().ca_certificate()), ca);
+}
+
+// Issue 28, defect 1: with only the CA's certificate moved away, init made a
+// new CA key over the old one and every enclave was orphaned.
+TEST_F(KeystoreTest, InitRefusesWhenAnyCaFileIsLeftAndKeepsTheKey) {
+  const std::string key = slurp(layout().ca_private_key());
+  ASSERT_EQ(std::remove(layout().ca_certificate().c_str()), 0);
+  auto again = init_keystore(dir(), {now_, 10});
+  ASSERT_FALSE(again);
+  EXPECT_NE(again.error().message.find("already has a CA (" + layout().ca_private_key()),
+            std::string::npos)
+      << again.error().message;
+  EXPECT_EQ(slurp(layout().ca_private_key()), key);
 }
 
 TEST_F(KeystoreTest, AddRefusesANameThatIsNotARosNameAndAKeystoreWithoutCa) {

@@ -240,8 +240,9 @@ const char* ceilpose_mode_name(uint8_t mode);
  * "none", "unusable_frame", "no_markers", ...; "unknown" beyond the last. */
 const char* ceilpose_refusal_name(unsigned index);
 
-/* Detailed message of the last failed call in this thread (names the segment,
- * its size and mode where relevant); "" if none. */
+/* Message of the last call in this thread: what failed, naming the segment,
+ * its size and mode where relevant; "" when that call succeeded. Every call
+ * sets it, so an older failure never shows after a later call. */
 const char* ceilpose_last_error_message(void);
 
 /* Layout checks, so C and C++ compilers agree on the shared bytes. */

@@ -37,6 +37,20 @@ TEST_F(CClient, OpenOfMissingSegmentReturnsNotFoundWithMessageNamingIt) {
   EXPECT_NE(std::string(ceilpose_last_error_message()).find(name()), std::string::npos);
 }
 
+// Issue 28, defect 16: a timeout on a good client reported the earlier
+// "no shm segment" of another open.
+TEST_F(CClient, TheLastErrorIsTheLastCallsNotAnOlderOne) {
+  ASSERT_NO_FATAL_FAILURE(start());
+  ceilpose_client* missing = nullptr;
+  ASSERT_EQ(ceilpose_client_open("/ceilpose-no-such-segment", &missing), CEILPOSE_ERR_NOT_FOUND);
+  ClientPtr client = open_client(name());
+  ASSERT_NE(client, nullptr);
+  EXPECT_STREQ(ceilpose_last_error_message(), "") << "the open succeeded";
+  ceilpose_pose p;
+  EXPECT_EQ(ceilpose_client_wait_next(client.get(), 0, 10, &p), CEILPOSE_ERR_TIMEOUT);
+  EXPECT_STREQ(ceilpose_last_error_message(), ceilpose_strerror(CEILPOSE_ERR_TIMEOUT));
+}
+
 TEST(CClientModeName, NamesEveryModeAsSpecPrintsIt) {
   EXPECT_STREQ(ceilpose_mode_name(CEILPOSE_MODE_AUTO), "auto");
   EXPECT_STREQ(ceilpose_mode_name(CEILPOSE_MODE_AXES), "axes");

@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "core/clock.h"
+#include "core/exit_codes.h"
 #include "core/refusal.h"
 #include "ipc/shm/shm_layout.h"
 #include "ipc/shm/shm_pose_reader.h"
@@ -24,7 +25,6 @@
 namespace ceilpose {
 namespace {
 
-constexpr int kExitNoDaemon = 3;  // ctl/command_registry.h
 constexpr int kRunTimeoutMs = 30'000;
 // ceilposectl can take seconds to start on a loaded machine; tests that
 // expect a live pose must not find it stale because of that.
@@ -360,6 +360,29 @@ TEST_F(CtlCommands, WatchReattachesAcrossDaemonRestart) {
   second->publish(sample_pose(7));
   EXPECT_EQ(watch.wait_exit(kRunTimeoutMs), 0) << watch.error_output();
   EXPECT_EQ(count_lines(watch.output()), 2u) << watch.output();
+  EXPECT_TRUE(contains(watch.output(), "\"timestamp_ns\":7")) << watch.output();
+}
+
+// Issue 28, defect 9: watch printed a dead daemon's last pose as valid and
+// exited 0. The last pose of a stopped daemon is not shown; the next
+// daemon's are.
+TEST_F(CtlCommands, WatchDoesNotShowAStoppedDaemonsLastPoseAsCurrent) {
+  ASSERT_NO_FATAL_FAILURE(start());
+  writer().publish(sample_pose(1));
+  writer().mark_stopped();
+  test::ChildProcess watch(ctl({"watch", "--shm", name(), "--json", "--count", "1"}),
+                           capturing_stderr());
+  ASSERT_TRUE(watch.started()) << watch.start_error();
+  ASSERT_TRUE(contains(watch.read_error_until("is not shown", kRunTimeoutMs), "is not shown"))
+      << watch.error_output();
+  writer_.reset();
+  ShmOptions options;
+  options.name = name();
+  auto second = ShmPoseWriter::create(options);
+  ASSERT_TRUE(second) << second.error().message;
+  second->publish(sample_pose(7));
+  EXPECT_EQ(watch.wait_exit(kRunTimeoutMs), 0) << watch.error_output();
+  EXPECT_EQ(count_lines(watch.output()), 1u) << watch.output();
   EXPECT_TRUE(contains(watch.output(), "\"timestamp_ns\":7")) << watch.output();
 }
 
