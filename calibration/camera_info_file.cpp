@@ -83,10 +83,10 @@ Result<CameraIntrinsics> read_camera_info_file(const std::string& path) {
   k.cx = m[2];
   k.fy = m[4];
   k.cy = m[5];
+  // Absent, distortion_model is plumb_bob: the five coefficients SPEC §9
+  // reads can mean nothing else (docs/decisions.md).
   const YAML::Node model = (*root)["distortion_model"];
-  if (!model.IsDefined() || model.IsNull())
-    return make_error(where(path, *root) + ": missing key 'distortion_model' (plumb_bob)");
-  if (!(model.IsScalar() && model.Scalar() == "plumb_bob")) {
+  if (model.IsDefined() && !(model.IsScalar() && model.Scalar() == "plumb_bob")) {
     return make_error(where(path, model) + ": distortion_model '" +
                       (model.IsScalar() ? model.Scalar() : std::string("?")) +
                       "' is not supported (ceilpose's camera model is plumb_bob, SPEC §3)");
