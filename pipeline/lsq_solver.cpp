@@ -168,24 +168,28 @@ LsqSolver::Fit LsqSolver::choose_tilt_model(const ViewGeometry& view,
     return free;
   }
   // The evidence: how much better the free model explains the points, in
-  // units of its own noise; and what leaving the tilt out would cost: how
-  // far the free pose is from the held one, in units of the free pose's own
-  // standard deviation.
+  // units of its own noise; and, only when that is significant, what leaving
+  // the tilt out would cost: how far the free pose is from the held one, in
+  // units of the free pose's own standard deviation (its normal equations
+  // cost a pass over the points: level views, the common case, skip it).
   LsqNormal a{};
   LsqVector b{};
   double wr2 = 0.0;
   int n = 0;
   const std::span<const bool> free_use(free.use.data(), fixes.size());
-  accumulate(view, params, points(), free_use, free.state, true, &a, &b, &wr2, &n);
-  prior_cost(view, params, free.model, free.state, &a, &b);
+  accumulate(view, params, points(), free_use, free.state, false, &a, &b, &wr2, &n);
   const double sigma2 = free.cost / std::max(1, 2 * n - free.model.free_count());
   out->tilt_chi2 = sigma2 > 0.0 ? (held.cost - free.cost) / sigma2 : 0.0;
   out->tilt_shift_m =
       std::hypot(free.state.t_w[0] - held.state.t_w[0], free.state.t_w[1] - held.state.t_w[1]);
-  out->tilt_free_sigma_m = position_sigma_m(free.model, a, wr2, n);
   const bool better = out->tilt_chi2 > params.lsq_tilt_select_chi2;
-  const bool matters =
-      out->tilt_shift_m > params.lsq_tilt_select_shift_sigmas * out->tilt_free_sigma_m;
+  bool matters = false;
+  if (better) {
+    accumulate(view, params, points(), free_use, free.state, true, &a, &b, &wr2, &n);
+    prior_cost(view, params, free.model, free.state, &a, &b);
+    out->tilt_free_sigma_m = position_sigma_m(free.model, a, wr2, n);
+    matters = out->tilt_shift_m > params.lsq_tilt_select_shift_sigmas * out->tilt_free_sigma_m;
+  }
   out->tilt_choice = better && matters ? TiltChoice::kFreeFits : TiltChoice::kHeldFits;
   return better && matters ? free : held;
 }

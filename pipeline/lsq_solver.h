@@ -46,7 +46,7 @@ struct LsqResult {
   // held-tilt one, metres, and by how much freeing the tilt lowered the
   // cost, in units of the free fit's noise (chi-square).
   double tilt_shift_m = 0.0;
-  double tilt_free_sigma_m = 0.0;  // the free-tilt pose's own 1-sigma, metres
+  double tilt_free_sigma_m = 0.0;  // the free-tilt pose's own 1-sigma, metres (0: not needed)
   double tilt_chi2 = 0.0;
   // Rolling shutter (camera.readout_ms > 0): the optical centre's velocity
   // and the yaw rate during the readout, world frame, when the markers span
