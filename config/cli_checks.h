@@ -21,19 +21,24 @@ inline CLI::Validator not_empty() {
       "NOT EMPTY");
 }
 
+// `value` read whole as a number (nan and inf included); false when it is
+// not one.
+inline bool whole_number(const std::string& value, double* out) {
+  try {
+    size_t used = 0;
+    *out = std::stod(value, &used);
+    return used == value.size();
+  } catch (const std::exception&) {
+    return false;
+  }
+}
+
 // A finite number of seconds above 0: nan, inf or 0 would never stop.
 inline CLI::Validator positive_seconds() {
   return CLI::Validator(
       [](const std::string& value) {
         double s = 0.0;
-        try {
-          size_t used = 0;
-          s = std::stod(value, &used);
-          if (used != value.size()) s = 0.0;
-        } catch (const std::exception&) {
-          s = 0.0;
-        }
-        return std::isfinite(s) && s > 0.0
+        return whole_number(value, &s) && std::isfinite(s) && s > 0.0
                    ? std::string()
                    : "must be a number of seconds above 0, got '" + value + "'";
       },
@@ -57,14 +62,10 @@ inline CLI::Validator finite_number() {
   return CLI::Validator(
       [](const std::string& value) {
         double v = 0.0;
-        try {
-          size_t used = 0;
-          v = std::stod(value, &used);
-          if (used != value.size()) return std::string();  // not a number: CLI11 says so
-        } catch (const std::exception&) {
-          return std::string();
-        }
-        return std::isfinite(v) ? std::string() : "must be a finite number, got '" + value + "'";
+        // Not a number at all: CLI11's own conversion says so.
+        return !whole_number(value, &v) || std::isfinite(v)
+                   ? std::string()
+                   : "must be a finite number, got '" + value + "'";
       },
       "FINITE");
 }
