@@ -273,6 +273,10 @@ void check_cross_keys(Reader& r, const ServiceConfig& c) {
       s.reconnect_max_ms >= s.reconnect_initial_ms, "capture.reconnect_max_ms",
       "expected at least capture.reconnect_initial_ms = " + std::to_string(s.reconnect_initial_ms) +
           ", found " + std::to_string(s.reconnect_max_ms));
+  r.require(c.fleet.remove_after_ms >= c.fleet.stale_after_ms, "fleet.remove_after_ms",
+            "expected at least fleet.stale_after_ms = " + std::to_string(c.fleet.stale_after_ms) +
+                " (a robot turns stale before it is removed), found " +
+                std::to_string(c.fleet.remove_after_ms));
   const int capture_priority = c.capture.thread.realtime_priority;
   r.require(c.capture.pipeline_rt_priority == 0 || capture_priority == 0 ||
                 c.capture.pipeline_rt_priority < capture_priority,

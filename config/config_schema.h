@@ -265,6 +265,16 @@ void describe(V& v, ServiceConfig& c) {
       v.text("enclave", d.security.enclave, &check_robot_name);
     });
   });
+  v.section("fleet", [&] {
+    FleetOptions& f = c.fleet;
+    v.field("enabled", f.enabled);
+    v.texts("robots", f.robots, &check_robot_name);
+    v.field("capacity", f.capacity, 1u, 65536u);
+    v.field("stale_after_ms", f.stale_after_ms, 10, 600'000);
+    v.field("remove_after_ms", f.remove_after_ms, 10, 3'600'000);
+    v.field("max_clock_offset_ms", f.max_clock_offset_ms, 0, 60'000);
+    v.field("history_depth", f.history_depth, 1, 1000);
+  });
   v.section("logging", [&] {
     v.choice("level", c.logging.level,
              Choices<LogLevel>{{"trace", LogLevel::kTrace},

@@ -13,6 +13,7 @@
 #include "capture/frame_source.h"
 #include "core/result.h"
 #include "ipc/dds/dds_options.h"
+#include "ipc/fleet/fleet_options.h"
 #include "ipc/shm/shm_pose_writer.h"
 #include "pipeline/pipeline_config.h"
 #include "pipeline/pose_estimate.h"
@@ -73,6 +74,7 @@ struct ServiceConfig {
   CaptureConfig capture;
   ShmOptions ipc;  // the shared-memory segment: name, group, stale_after_ms
   DdsConfig dds;
+  FleetOptions fleet;  // the other robots' poses in <shm>-fleet (SPEC §12)
   LoggingConfig logging;
   WatchdogConfig watchdog;
 };

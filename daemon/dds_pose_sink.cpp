@@ -1,6 +1,7 @@
 #include "daemon/dds_pose_sink.h"
 
 #include "core/clock.h"
+#include "daemon/pose_record_of.h"
 #include "ipc/dds/dds_pose_publisher.h"
 
 namespace ceilpose::daemon {
@@ -8,8 +9,9 @@ namespace ceilpose::daemon {
 void DdsPoseSink::consume(const Localization& loc) {
   // ROS consumers take any pose on the topic as a fix: invalid ones stay off it.
   if (!loc.published.valid) return;
+  const PoseRecord record = pose_record_of(loc, realtime_ns() - monotonic_ns());
   DdsPose pose;
-  pose.capture_realtime_ns = loc.frame.timestamp_ns + (realtime_ns() - monotonic_ns());
+  pose.capture_realtime_ns = record.capture_real_ns;
   pose.valid = true;
   pose.pose = loc.published.pose;
   pose.covariance = loc.published.covariance;
@@ -22,6 +24,11 @@ void DdsPoseSink::consume(const Localization& loc) {
         pose.velocity_covariance[r * 3 + c] = s.p[(3 + r) * kMotionStates + 3 + c];
   }
   if (!publisher_->publish(pose)) failures_.fetch_add(1, std::memory_order_relaxed);
+  // The fleet's copy carries the pose sequence of this output, so that
+  // receivers can count lost samples.
+  PoseRecord state = record;
+  state.seq = ++state_seq_;
+  if (!publisher_->publish_state(state)) failures_.fetch_add(1, std::memory_order_relaxed);
 }
 
 void DdsPoseSink::publish_status(const ServiceStatus& s) {

@@ -1,5 +1,7 @@
 #pragma once
-// DDS output of ceilposed: valid poses on rt/<robot>/pose, the health on
+// DDS output of ceilposed: valid poses on rt/<robot>/pose (with odometry on
+// rt/<robot>/odom and the full state for the fleet on
+// rt/<robot>/ceilpose_state), the health on
 // rt/<robot>/ceilpose_status every dds.status_period_ms. A failed write is
 // counted, never logged from the pipeline thread.
 #include <atomic>
@@ -28,6 +30,7 @@ class DdsPoseSink final : public PublishingSink {
  private:
   DdsPosePublisher* publisher_;
   int64_t status_period_ns_;
+  uint64_t state_seq_ = 0;  // pipeline thread only
   std::atomic<uint64_t> failures_{0};
   std::atomic<size_t> other_pose_writers_{0};
 };

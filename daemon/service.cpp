@@ -22,6 +22,7 @@
 #include "core/clock.h"
 #include "core/exit_codes.h"
 #include "daemon/dds_pose_sink.h"
+#include "daemon/fleet_thread.h"
 #include "daemon/logging.h"
 #include "daemon/pipeline_worker.h"
 #include "daemon/pose_printer.h"
@@ -102,6 +103,7 @@ class Service {
   int start_capture();
   int start_shared_memory();
   int start_dds();
+  int start_fleet();
   int start_pipeline();
   void raise_control_priority();
   void loop();
@@ -135,6 +137,7 @@ class Service {
   std::optional<ShmPoseSink> shm_sink_;
   std::optional<DdsPosePublisher> dds_;
   std::optional<DdsPoseSink> dds_sink_;
+  std::unique_ptr<FleetThread> fleet_;  // stopped before dds_ is disposed
   // The enclave's files once check_keystore() found them good; unset: plain DDS.
   std::optional<DdsSecurityFiles> dds_security_;
   std::vector<PublishingSink*> sinks_;
@@ -147,7 +150,7 @@ int Service::start() {
   start_ns_ = monotonic_ns();
   for (int (Service::*step)() :
        {&Service::check_keystore, &Service::start_capture, &Service::start_shared_memory,
-        &Service::start_dds, &Service::start_pipeline}) {
+        &Service::start_dds, &Service::start_fleet, &Service::start_pipeline}) {
     if (const int rc = (this->*step)(); rc != kExitOk) return rc;
   }
   raise_control_priority();
@@ -239,6 +242,32 @@ int Service::start_dds() {
   sinks_.push_back(&*dds_sink_);
   spdlog::info("DDS: domain {} topic {}, status every {} ms", dds_->domain_id(), dds_->pose_topic(),
                config_.dds.status_period_ms);
+  return kExitOk;
+}
+
+// The other robots' poses in <shm>-fleet. A fleet that cannot start stops
+// the daemon like any other output that cannot: the configuration asked for it.
+int Service::start_fleet() {
+  if (!config_.fleet.enabled) return kExitOk;
+  if (!dds_) {
+    spdlog::warn("fleet: off, because dds.enabled is false (the fleet arrives over DDS)");
+    return kExitOk;
+  }
+  shm::ShmErrc code = shm::ShmErrc::kOk;
+  auto fleet = FleetThread::create(config_.fleet, config_.ipc.name, config_.ipc.group,
+                                   dds_->participant_handle(), dds_->robot(), &code);
+  if (!fleet) {
+    spdlog::error("fleet: {}", fleet.error().message);
+    return code == shm::ShmErrc::kNameTaken || code == shm::ShmErrc::kLiveWriter ? kExitShmNameTaken
+                                                                                 : kExitFailure;
+  }
+  fleet_ = std::move(fleet).value();
+  fleet_->start();
+  spdlog::info(
+      "fleet: {} holds up to {} robots of DDS domain {} (rt/*/ceilpose_state), stale after "
+      "{} ms, removed after {} ms",
+      fleet_->segment_name(), config_.fleet.capacity, dds_->domain_id(),
+      config_.fleet.stale_after_ms, config_.fleet.remove_after_ms);
   return kExitOk;
 }
 
@@ -445,6 +474,7 @@ void Service::shutdown() {
   if (worker_) worker_->stop();
   if (capture_) capture_->stop();
   if (shm_) shm_->mark_stopped();
+  if (fleet_) fleet_->stop();
   if (dds_) dds_->dispose();
   if (worker_) {
     const capture::CaptureStats cs = capture_->stats();

@@ -3,26 +3,12 @@
 #include <algorithm>
 
 #include "core/clock.h"
+#include "daemon/pose_record_of.h"
 
 namespace ceilpose::daemon {
 
 void ShmPoseSink::consume(const Localization& loc) {
-  const PoseEstimate& out = loc.published;
-  const int64_t real_minus_mono_ns = realtime_ns() - monotonic_ns();
-  PoseRecord rec{};
-  rec.capture_mono_ns = loc.frame.timestamp_ns;
-  rec.capture_real_ns = loc.frame.timestamp_ns + real_minus_mono_ns;
-  rec.x_m = out.pose.x_m;
-  rec.y_m = out.pose.y_m;
-  rec.yaw_rad = out.pose.yaw_rad;
-  std::copy(out.covariance.begin(), out.covariance.end(), rec.covariance);
-  rec.flags = (out.valid ? kPoseValid : 0u) | (loc.filtered ? kPoseFiltered : 0u) |
-              (loc.coasting() ? kPoseCoasting : 0u);
-  rec.mode = static_cast<uint8_t>(out.mode);
-  rec.markers = static_cast<uint16_t>(out.markers);
-  rec.refusal = static_cast<uint8_t>(out.refusal);
-  set_pose_motion(&rec, loc.motion);
-  writer_->publish(rec);
+  writer_->publish(pose_record_of(loc, realtime_ns() - monotonic_ns()));
 }
 
 void ShmPoseSink::publish_status(const ServiceStatus& s) {

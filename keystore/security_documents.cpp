@@ -76,7 +76,7 @@ std::string governance_xml() {
 std::string publish_topic_pattern(const std::string& robot) { return "rt/" + robot + "/*"; }
 
 std::vector<std::string> subscribe_topic_patterns() {
-  return {"rt/*/pose", "rt/*/ceilpose_status"};
+  return {"rt/*/pose", "rt/*/ceilpose_status", "rt/*/ceilpose_state"};
 }
 
 std::string permissions_xml(const std::string& robot, std::time_t not_before,

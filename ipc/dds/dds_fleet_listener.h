@@ -16,6 +16,7 @@
 #include "ipc/dds/dds_messages.h"
 #include "ipc/dds/dds_options.h"
 #include "ipc/dds/dds_participant.h"
+#include "ipc/dds/dds_topic_discovery.h"
 
 namespace ceilpose {
 
@@ -56,7 +57,7 @@ class DdsFleetListener {
   };
 
   DdsParticipant participant_;  // parent of every entity below
-  dds_entity_t publication_reader_ = 0;
+  DdsTopicDiscovery discovery_;
   dds_entity_t waitset_ = 0;
   std::map<std::string, Entry> entries_;  // by DDS topic name
 };

@@ -1,6 +1,8 @@
 #include "ipc/dds/dds_messages.h"
 
+#include <algorithm>
 #include <cmath>
+#include <iterator>
 
 namespace ceilpose {
 namespace {
@@ -17,6 +19,10 @@ builtin_interfaces_msg_dds__Time_ to_time(int64_t realtime_ns) {
     sec -= 1;
   }
   return {static_cast<int32_t>(sec), static_cast<uint32_t>(nsec)};
+}
+
+int64_t from_time(const builtin_interfaces_msg_dds__Time_& t) {
+  return int64_t{t.sec} * kNsPerS + t.nanosec;
 }
 
 // Row/column of x, y and rotation about z in ROS's 6x6 pose covariance
@@ -93,8 +99,7 @@ void to_message(const DdsPose& pose, nav_msgs_msg_dds__Odometry_* msg) {
 DdsPose from_message(const geometry_msgs_msg_dds__PoseWithCovarianceStamped_& msg) {
   DdsPose out;
   out.valid = true;
-  out.capture_realtime_ns =
-      static_cast<int64_t>(msg.header.stamp.sec) * kNsPerS + msg.header.stamp.nanosec;
+  out.capture_realtime_ns = from_time(msg.header.stamp);
   const auto& p = msg.pose.pose;
   out.pose.x_m = p.position.x;
   out.pose.y_m = p.position.y;
@@ -128,6 +133,53 @@ void to_message(const DdsStatus& status, const std::string& robot, ceilpose_msg_
   static_assert(kRefusalCount <= kSlots, "ceilpose_status.idl has a slot for every refusal");
   for (size_t i = 0; i < kSlots; ++i)
     msg->refusals[i] = i < status.refusals.size() ? status.refusals[i] : 0;
+}
+
+void to_message(const PoseRecord& pose, ceilpose_msg_dds__State_* msg) {
+  msg->header.stamp = to_time(pose.capture_real_ns);
+  msg->header.frame_id = const_cast<char*>(kMapFrame);
+  msg->seq = pose.seq;
+  msg->flags = pose.flags;
+  msg->mode = pose.mode;
+  msg->markers = pose.markers;
+  msg->x = pose.x_m;
+  msg->y = pose.y_m;
+  msg->yaw = pose.yaw_rad;
+  std::copy(std::begin(pose.covariance), std::end(pose.covariance), msg->covariance);
+  msg->velocity[0] = pose.vx_mps;
+  msg->velocity[1] = pose.vy_mps;
+  msg->velocity[2] = pose.yaw_rate_radps;
+  msg->acceleration[0] = pose.ax_mps2;
+  msg->acceleration[1] = pose.ay_mps2;
+  msg->acceleration[2] = pose.yaw_accel_radps2;
+  std::copy(std::begin(pose.state_covariance), std::end(pose.state_covariance),
+            msg->state_covariance);
+  std::copy(std::begin(pose.jerk_density), std::end(pose.jerk_density), msg->jerk_density);
+  msg->predict_horizon_ms = pose.predict_horizon_ms;
+}
+
+PoseRecord from_message(const ceilpose_msg_dds__State_& msg) {
+  PoseRecord pose{};
+  pose.capture_real_ns = from_time(msg.header.stamp);
+  pose.seq = msg.seq;
+  pose.flags = msg.flags;
+  pose.mode = msg.mode;
+  pose.markers = msg.markers;
+  pose.x_m = msg.x;
+  pose.y_m = msg.y;
+  pose.yaw_rad = msg.yaw;
+  std::copy(std::begin(msg.covariance), std::end(msg.covariance), pose.covariance);
+  pose.vx_mps = msg.velocity[0];
+  pose.vy_mps = msg.velocity[1];
+  pose.yaw_rate_radps = msg.velocity[2];
+  pose.ax_mps2 = msg.acceleration[0];
+  pose.ay_mps2 = msg.acceleration[1];
+  pose.yaw_accel_radps2 = msg.acceleration[2];
+  std::copy(std::begin(msg.state_covariance), std::end(msg.state_covariance),
+            pose.state_covariance);
+  std::copy(std::begin(msg.jerk_density), std::end(msg.jerk_density), pose.jerk_density);
+  pose.predict_horizon_ms = msg.predict_horizon_ms;
+  return pose;
 }
 
 }  // namespace ceilpose

@@ -31,16 +31,27 @@ std::string status_topic_name(std::string_view robot) {
 
 std::string odom_topic_name(std::string_view robot) { return "rt/" + std::string(robot) + "/odom"; }
 
-std::string robot_from_pose_topic(std::string_view topic) {
+std::string state_topic_name(std::string_view robot) {
+  return "rt/" + std::string(robot) + "/ceilpose_state";
+}
+
+std::string robot_from_topic(std::string_view topic, std::string_view suffix) {
   constexpr std::string_view kPrefix = "rt/";
-  constexpr std::string_view kSuffix = "/pose";
-  if (topic.size() <= kPrefix.size() + kSuffix.size() || !topic.starts_with(kPrefix) ||
-      !topic.ends_with(kSuffix)) {
+  if (topic.size() <= kPrefix.size() + suffix.size() || !topic.starts_with(kPrefix) ||
+      !topic.ends_with(suffix)) {
     return {};
   }
   const std::string_view robot =
-      topic.substr(kPrefix.size(), topic.size() - kPrefix.size() - kSuffix.size());
+      topic.substr(kPrefix.size(), topic.size() - kPrefix.size() - suffix.size());
   return is_valid_ros_name(robot) ? std::string(robot) : std::string();
+}
+
+std::string robot_from_pose_topic(std::string_view topic) {
+  return robot_from_topic(topic, "/pose");
+}
+
+std::string robot_from_state_topic(std::string_view topic) {
+  return robot_from_topic(topic, "/ceilpose_state");
 }
 
 Result<void> validate(const DdsDomainOptions& options) {

@@ -65,8 +65,14 @@ std::string pose_topic_name(std::string_view robot);    // "rt/<robot>/pose"
 std::string status_topic_name(std::string_view robot);  // "rt/<robot>/ceilpose_status"
 std::string odom_topic_name(std::string_view robot);    // "rt/<robot>/odom"
 
-// For a DDS topic name of the form rt/<robot>/pose returns <robot>, else empty.
-std::string robot_from_pose_topic(std::string_view topic);
+// rt/<robot>/ceilpose_state: the full state the fleet keeps (SPEC §12).
+std::string state_topic_name(std::string_view robot);
+
+// For a DDS topic name rt/<robot><suffix> returns <robot> if it is a valid
+// ROS name, else empty.
+std::string robot_from_topic(std::string_view topic, std::string_view suffix);
+std::string robot_from_pose_topic(std::string_view topic);   // rt/<robot>/pose
+std::string robot_from_state_topic(std::string_view topic);  // rt/<robot>/ceilpose_state
 
 // Checks ranges and names, the messages naming the offending option.
 Result<void> validate(const DdsDomainOptions& options);

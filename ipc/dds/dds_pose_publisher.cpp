@@ -54,6 +54,7 @@ Result<DdsPosePublisher> DdsPosePublisher::create(const DdsOptions& options) {
   pub.pose_topic_ = pose_topic_name(options.robot);
   pub.status_topic_ = status_topic_name(options.robot);
   pub.odom_topic_ = odom_topic_name(options.robot);
+  pub.state_topic_ = state_topic_name(options.robot);
 
   auto pose_writer =
       create_writer(pub.participant_, &geometry_msgs_msg_dds__PoseWithCovarianceStamped__desc,
@@ -68,6 +69,10 @@ Result<DdsPosePublisher> DdsPosePublisher::create(const DdsOptions& options) {
       create_writer(pub.participant_, &nav_msgs_msg_dds__Odometry__desc, pub.odom_topic_, options);
   if (!odom_writer) return odom_writer.error();
   pub.odom_writer_ = *odom_writer;
+  auto state_writer =
+      create_writer(pub.participant_, &ceilpose_msg_dds__State__desc, pub.state_topic_, options);
+  if (!state_writer) return state_writer.error();
+  pub.state_writer_ = *state_writer;
   pub.publication_reader_ = dds_create_reader(pub.participant_.handle(),
                                               DDS_BUILTIN_TOPIC_DCPSPUBLICATION, nullptr, nullptr);
   if (pub.publication_reader_ < 0) {
@@ -140,11 +145,23 @@ Result<void> DdsPosePublisher::publish_status(const DdsStatus& status) {
   return {};
 }
 
+Result<void> DdsPosePublisher::publish_state(const PoseRecord& pose) {
+  if (!participant_.valid()) return make_error("DDS publisher of " + robot_ + " was disposed");
+  if (!pose_is_valid(pose))
+    return make_error("refusing to publish an invalid pose on " + state_topic_);
+  ceilpose_msg_dds__State_ msg;
+  to_message(pose, &msg);
+  const dds_return_t rc = dds_write(state_writer_, &msg);
+  if (rc != DDS_RETCODE_OK) return dds_error("cannot write a state to " + state_topic_, rc);
+  return {};
+}
+
 void DdsPosePublisher::dispose() {
   participant_.reset();
   pose_writer_ = 0;
   status_writer_ = 0;
   odom_writer_ = 0;
+  state_writer_ = 0;
   publication_reader_ = 0;
   other_writers_.clear();
 }

@@ -1,9 +1,10 @@
 #pragma once
 // Publishes a robot's poses as ROS 2 geometry_msgs/msg/PoseWithCovarianceStamped
 // on rt/<robot>/pose (ROS topic /<robot>/pose), the same with the filter's
-// twist as nav_msgs/msg/Odometry on rt/<robot>/odom, and its health as
-// ceilpose/msg/Status on rt/<robot>/ceilpose_status, both XCDR1 as ROS 2
-// Humble/Iron expect.
+// twist as nav_msgs/msg/Odometry on rt/<robot>/odom, its health as
+// ceilpose/msg/Status on rt/<robot>/ceilpose_status and its full state as
+// ceilpose/msg/State on rt/<robot>/ceilpose_state (the fleet, SPEC §12),
+// all XCDR1 as ROS 2 Humble/Iron expect.
 //
 // Lifecycle: create() builds participant -> topics -> writers and fails with
 // a message naming the step; publish()/publish_status() write; dispose() (or
@@ -33,6 +34,9 @@ class DdsPosePublisher {
   // callers publish valid poses only, and the status topic reports no fix.
   Result<void> publish(const DdsPose& pose);
   Result<void> publish_status(const DdsStatus& status);
+  // The full state (pose, motion, covariances) on rt/<robot>/ceilpose_state
+  // for the other robots' fleet segments; valid poses only, like publish().
+  Result<void> publish_state(const PoseRecord& pose);
 
   // Leaves the domain now: remote readers see the writers go. Idempotent;
   // publishing afterwards fails.
@@ -42,6 +46,7 @@ class DdsPosePublisher {
   const std::string& pose_topic() const { return pose_topic_; }
   const std::string& status_topic() const { return status_topic_; }
   const std::string& odom_topic() const { return odom_topic_; }
+  const std::string& state_topic() const { return state_topic_; }
   uint32_t domain_id() const { return participant_.domain_id(); }
   // For entities that should share this participant (one participant per
   // process is the cheapest for discovery); 0 after dispose().
@@ -61,10 +66,12 @@ class DdsPosePublisher {
   dds_entity_t pose_writer_ = 0;  // children of participant_: deleted with it
   dds_entity_t status_writer_ = 0;
   dds_entity_t odom_writer_ = 0;
+  dds_entity_t state_writer_ = 0;
   std::string robot_;
   std::string pose_topic_;
   std::string status_topic_;
   std::string odom_topic_;
+  std::string state_topic_;
   uint64_t published_ = 0;
   dds_entity_t publication_reader_ = 0;  // DCPSPublication, child of participant_
   dds_guid_t own_guid_{};

@@ -8,10 +8,15 @@
 
 #include "core/refusal.h"
 #include "ipc/shm/pose_record.h"
+#include "ipc/shm/shm_fleet_reader.h"
 #include "ipc/shm/shm_pose_reader.h"
 
 struct ceilpose_client {
   ceilpose::ShmPoseReader reader;
+};
+
+struct ceilpose_fleet {
+  ceilpose::ShmFleetReader reader;
 };
 
 namespace {
@@ -23,9 +28,10 @@ thread_local std::string g_last_detail;
 thread_local const char* g_last_message = "";
 
 // A failure whose message names what failed (open, reattach).
-int set_error(int code, const char* detail) {
+int set_error(int code, const char* detail, const char* detail_tail = "") {
   try {
     g_last_detail = detail;
+    g_last_detail += detail_tail;
     g_last_message = g_last_detail.c_str();
   } catch (...) {
     g_last_message = ceilpose_strerror(code);
@@ -67,25 +73,31 @@ int read_code(ceilpose::ReadResult r) {
   return CEILPOSE_ERR_SYSTEM;
 }
 
+// Opens a reader of kind Reader on `name` into a new Handle{reader}; what:
+// "pose segment", "fleet segment" for the messages.
+template <typename Handle, typename Reader>
+int open_handle(const char* name, Handle** out, const char* what) {
+  if (out == nullptr) return set_error(CEILPOSE_ERR_INVALID_ARGUMENT, "out handle is NULL");
+  *out = nullptr;
+  try {
+    ceilpose::shm::ShmErrc code = ceilpose::shm::ShmErrc::kOk;
+    auto reader = Reader::open(name != nullptr ? name : CEILPOSE_DEFAULT_SHM_NAME, &code);
+    if (!reader) return set_error(static_cast<int>(code), reader.error().message.c_str());
+    *out = new Handle{std::move(reader.value())};
+    return outcome(CEILPOSE_OK);
+  } catch (const std::bad_alloc&) {
+    return set_error(CEILPOSE_ERR_NO_MEMORY, "out of memory opening the ", what);
+  } catch (...) {
+    return set_error(CEILPOSE_ERR_SYSTEM, "unexpected error opening the ", what);
+  }
+}
+
 }  // namespace
 
 extern "C" {
 
 int ceilpose_client_open(const char* name, ceilpose_client** out) {
-  if (out == nullptr) return set_error(CEILPOSE_ERR_INVALID_ARGUMENT, "out handle is NULL");
-  *out = nullptr;
-  try {
-    ceilpose::shm::ShmErrc code = ceilpose::shm::ShmErrc::kOk;
-    auto reader =
-        ceilpose::ShmPoseReader::open(name != nullptr ? name : CEILPOSE_DEFAULT_SHM_NAME, &code);
-    if (!reader) return set_error(static_cast<int>(code), reader.error().message.c_str());
-    *out = new ceilpose_client{std::move(reader.value())};
-    return outcome(CEILPOSE_OK);
-  } catch (const std::bad_alloc&) {
-    return set_error(CEILPOSE_ERR_NO_MEMORY, "out of memory opening the pose segment");
-  } catch (...) {
-    return set_error(CEILPOSE_ERR_SYSTEM, "unexpected error opening the pose segment");
-  }
+  return open_handle<ceilpose_client, ceilpose::ShmPoseReader>(name, out, "pose segment");
 }
 
 void ceilpose_client_close(ceilpose_client* client) { delete client; }
@@ -185,6 +197,35 @@ int ceilpose_client_read_recent(ceilpose_client* client, ceilpose_pose* out, uin
   const int limit = max_poses > CEILPOSE_POSE_RING_LENGTH ? CEILPOSE_POSE_RING_LENGTH
                                                           : static_cast<int>(max_poses);
   *count = static_cast<uint32_t>(client->reader.read_recent(out, limit));
+  return outcome(CEILPOSE_OK);
+}
+
+int ceilpose_client_fleet_open(const char* shm, ceilpose_fleet** out) {
+  return open_handle<ceilpose_fleet, ceilpose::ShmFleetReader>(shm, out, "fleet segment");
+}
+
+void ceilpose_client_fleet_close(ceilpose_fleet* fleet) { delete fleet; }
+
+int ceilpose_client_fleet_read(ceilpose_fleet* fleet, int64_t t_mono_ns, ceilpose_fleet_robot* out,
+                               uint32_t max_robots, uint32_t* count) {
+  if (fleet == nullptr || count == nullptr || (out == nullptr && max_robots > 0)) {
+    return outcome(CEILPOSE_ERR_INVALID_ARGUMENT);
+  }
+  *count = fleet->reader.read(t_mono_ns, out, max_robots);
+  return outcome(CEILPOSE_OK);
+}
+
+int ceilpose_client_fleet_find(ceilpose_fleet* fleet, const char* robot, int64_t t_mono_ns,
+                               ceilpose_fleet_robot* out) {
+  if (fleet == nullptr || robot == nullptr || out == nullptr) {
+    return outcome(CEILPOSE_ERR_INVALID_ARGUMENT);
+  }
+  return outcome(fleet->reader.find(robot, t_mono_ns, out) ? CEILPOSE_OK : CEILPOSE_ERR_NO_POSE);
+}
+
+int ceilpose_client_fleet_info(ceilpose_fleet* fleet, ceilpose_fleet_info* out) {
+  if (fleet == nullptr || out == nullptr) return outcome(CEILPOSE_ERR_INVALID_ARGUMENT);
+  *out = fleet->reader.info();
   return outcome(CEILPOSE_OK);
 }
 

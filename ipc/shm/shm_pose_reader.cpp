@@ -15,6 +15,7 @@
 #include "core/clock.h"
 #include "core/futex.h"
 #include "ipc/shm/shm_layout.h"
+#include "ipc/shm/shm_segment_file.h"
 
 namespace ceilpose {
 
@@ -29,20 +30,6 @@ namespace {
 // A reader blocked in wait_next re-checks that its writer still exists this
 // often, so a crashed daemon is reported even with an infinite timeout.
 constexpr int64_t kLivenessCheckNs = 250'000'000;
-
-// Owner and mode of a segment we may not be allowed to open, for the message.
-std::string describe_access(const std::string& name) {
-  struct stat st {};
-  const std::string path = "/dev/shm" + name;  // where Linux keeps POSIX shm
-  std::string text;
-  if (::stat(path.c_str(), &st) == 0) {
-    text = "segment is mode " + shm::mode_text(st.st_mode) + ", owner uid " +
-           std::to_string(st.st_uid) + " gid " + std::to_string(st.st_gid) + ", " +
-           std::to_string(st.st_size) + " bytes; ";
-  }
-  return text + "this process is uid " + std::to_string(::geteuid()) + " gid " +
-         std::to_string(::getegid()) + " (is it in the segment's group?)";
-}
 
 inline void cpu_relax() {
 #if defined(__x86_64__) || defined(__i386__)
@@ -130,94 +117,13 @@ struct ShmPoseReader::Impl {
 
 namespace {
 
-// An open segment: its fd, its mapping and what fstat said.
-struct OpenedSegment {
-  UniqueFd fd;
-  Mapping mapping;
-  struct stat st {};
-};
-
-// A writer sizes and fills a new segment within milliseconds of creating it;
-// one still empty or without a header after this long is not being created
-// by anyone (another program's file, or a writer that died creating it).
-constexpr int64_t kCreationGraceNs = 2'000'000'000;
-
-// Seconds since the segment's size last changed (ftruncate sets the mtime).
-double seconds_since_sized(const struct stat& st) {
-  const int64_t sized_ns = int64_t{st.st_mtim.tv_sec} * 1'000'000'000 + st.st_mtim.tv_nsec;
-  return static_cast<double>(realtime_ns() - sized_ns) * 1e-9;
-}
-
-// kNotReady while a writer could still be creating the segment, kBadMagic
-// once none can be.
-Error not_ready_or_foreign(const std::string& name, const struct stat& st, const std::string& what,
-                           ShmErrc* code) {
-  const double age_s = seconds_since_sized(st);
-  if (age_s * 1e9 < static_cast<double>(kCreationGraceNs)) {
-    return fail(code, ShmErrc::kNotReady,
-                "shm segment " + name + " is " + what + ": its writer is still creating it");
-  }
-  char age[32];
-  std::snprintf(age, sizeof age, "%.0f s", age_s);
-  return fail(code, ShmErrc::kBadMagic,
-              "shm segment " + name + " is " + what + " " + age +
-                  " after it was sized: not a ceilpose segment (another program's file, or a "
-                  "writer that died creating it); remove /dev/shm" +
-                  name + " (as its owner or root)");
-}
-
-// Opens and maps the pose segment read-only, refusing one too small to hold
-// a header.
-Result<OpenedSegment> open_pose_segment(const std::string& name, ShmErrc* code) {
-  OpenedSegment out;
-  out.fd = UniqueFd(::shm_open(name.c_str(), O_RDONLY | O_CLOEXEC, 0));
-  if (!out.fd.valid()) {
-    const int e = errno;
-    if (e == ENOENT) {
-      return fail(code, ShmErrc::kNotFound,
-                  "no shm segment " + name + " (no ceilposed publishing on it; is it running " +
-                      "with --shm " + name + "?)");
-    }
-    if (e == EACCES) {
-      return fail(code, ShmErrc::kPermission,
-                  "permission denied opening shm segment " + name + ": " + describe_access(name));
-    }
-    return fail(code, shm::errc_from_errno(e),
-                "cannot open shm segment " + name + ": " + shm::errno_text(e));
-  }
-  if (::fstat(out.fd.get(), &out.st) != 0) {
-    const int e = errno;
-    return fail(code, ShmErrc::kSystem,
-                "cannot stat shm segment " + name + ": " + shm::errno_text(e));
-  }
-  const auto size_bytes = static_cast<size_t>(out.st.st_size);
-  if (size_bytes == 0) return not_ready_or_foreign(name, out.st, "empty", code);
-  constexpr size_t kIdentityBytes = offsetof(shm::SegmentHeader, header_size);
-  if (size_bytes < kIdentityBytes) {
-    return fail(code, ShmErrc::kBadSize,
-                "shm segment " + name + " is " + std::to_string(size_bytes) +
-                    " bytes, too small for a ceilpose header (ABI " +
-                    std::to_string(shm::kAbiVersion) + " expects " +
-                    std::to_string(sizeof(Segment)) + " bytes)");
-  }
-  int map_error = 0;
-  out.mapping = shm::map_shared(out.fd.get(), std::min(size_bytes, sizeof(Segment)), false,
-                                shm::OnShrink::kDetach, &map_error);
-  if (out.mapping.get() == nullptr) {
-    return fail(code, shm::errc_from_errno(map_error),
-                "cannot map shm segment " + name + " (" + std::to_string(size_bytes) +
-                    " bytes): " + shm::errno_text(map_error));
-  }
-  return out;
-}
-
 // The header must be complete (magic), ours (magic), of our ABI and of the
 // sizes this ABI lays out.
 Result<void> check_header(const Segment& seg, const struct stat& st, const std::string& name,
                           ShmErrc* code) {
   const auto size_bytes = static_cast<size_t>(st.st_size);
   const uint64_t magic = seg.header.magic.load(std::memory_order_acquire);
-  if (magic == 0) return not_ready_or_foreign(name, st, "without a header", code);
+  if (magic == 0) return shm::not_ready_or_foreign(name, st, "without a header", code);
   if (magic != shm::kMagic) {
     return fail(code, ShmErrc::kBadMagic,
                 "shm segment " + name + " is not a ceilpose pose segment (bad magic)");
@@ -248,17 +154,17 @@ Result<void> check_header(const Segment& seg, const struct stat& st, const std::
 // pose segment's writer made: the inode its header names (a group reader
 // writing garbage into -wake then locks nobody out), or for writers that do
 // not record it, the writer's magic and generation.
-Result<OpenedSegment> open_wake_segment(const std::string& name, uint64_t generation,
-                                        uint64_t wake_inode, ShmErrc* code) {
+Result<shm::OpenedSegment> open_wake_segment(const std::string& name, uint64_t generation,
+                                             uint64_t wake_inode, ShmErrc* code) {
   const std::string wake_name = shm::wake_segment_name(name);
-  OpenedSegment out;
+  shm::OpenedSegment out;
   out.fd = UniqueFd(::shm_open(wake_name.c_str(), O_RDWR | O_CLOEXEC, 0));
   if (!out.fd.valid()) {
     const int e = errno;
     if (e == EACCES) {
       return fail(code, ShmErrc::kPermission,
                   "permission denied opening shm segment " + wake_name +
-                      " read-write (needed to wait for poses): " + describe_access(wake_name));
+                      " read-write (needed to wait for poses): " + shm::describe_access(wake_name));
     }
     return fail(code, shm::errc_from_errno(e),
                 "cannot open shm segment " + wake_name + " (companion of " + name +
@@ -299,7 +205,8 @@ Result<ShmPoseReader> ShmPoseReader::open(const std::string& name, ShmErrc* code
     return fail(code, ShmErrc::kInvalidArgument,
                 "invalid shm segment name '" + name + "': must be " + shm::kShmNameRule);
   }
-  auto pose = open_pose_segment(name, code);
+  auto pose = shm::open_segment_readonly(
+      name, {"pose", offsetof(shm::SegmentHeader, header_size), sizeof(Segment), name}, code);
   if (!pose) return pose.error();
   const auto* seg = static_cast<const Segment*>(pose->mapping.get());
   if (auto ok = check_header(*seg, pose->st, name, code); !ok) return ok.error();

@@ -20,6 +20,7 @@
 #include "core/clock.h"
 #include "core/futex.h"
 #include "ipc/shm/shm_layout.h"
+#include "ipc/shm/shm_segment_file.h"
 
 namespace ceilpose {
 
@@ -34,8 +35,6 @@ namespace {
 constexpr mode_t kSegmentMode = 0640;
 // Readers must write the waiter count, so the companion is group-writable.
 constexpr mode_t kWakeMode = 0660;
-// Creation races with another creator at most a couple of times.
-constexpr int kCreateAttempts = 3;
 
 // Reads the writer pid of an existing segment for the "live writer" message;
 // 0 when the segment is not (yet) a valid one.
@@ -60,31 +59,7 @@ void wake_readers_of(int fd) {
   futex_wake_all(&static_cast<const Segment*>(m.get())->header.wake_seq, FutexScope::kShared);
 }
 
-uint64_t new_generation() {
-  // Unique per start: two writers never share both a pid and a nanosecond.
-  const uint64_t g = static_cast<uint64_t>(realtime_ns()) ^
-                     (static_cast<uint64_t>(::getpid()) << 40) ^
-                     static_cast<uint64_t>(monotonic_ns());
-  return g == 0 ? 1 : g;
-}
-
-Result<void> set_owner_and_mode(int fd, const std::string& name, mode_t mode, gid_t gid,
-                                ShmErrc* code) {
-  // fchmod, not the shm_open mode: the process umask must not narrow it.
-  if (::fchmod(fd, mode) != 0) {
-    const int e = errno;
-    return fail(code, shm::errc_from_errno(e),
-                "cannot set mode " + shm::mode_text(mode) + " on shm segment " + name + ": " +
-                    shm::errno_text(e));
-  }
-  if (::fchown(fd, static_cast<uid_t>(-1), gid) != 0) {
-    const int e = errno;
-    return fail(code, shm::errc_from_errno(e),
-                "cannot give shm segment " + name + " to group id " + std::to_string(gid) + ": " +
-                    shm::errno_text(e));
-  }
-  return {};
-}
+constexpr shm::SegmentOwnerHooks kPoseSegmentHooks{&existing_writer_pid, &wake_readers_of};
 
 }  // namespace
 
@@ -247,110 +222,11 @@ Result<void> check_options(const ShmOptions& options, ShmErrc* code) {
   return {};
 }
 
-// What sits at /dev/shm/<name> when it is not a segment this daemon's user
-// may replace, for the error message; empty when it is one (a regular file
-// of ours) or nothing is there. /dev/shm is world-writable and sticky: any
-// local user can put a file, a link or a directory at our name, and only its
-// owner or root can remove it.
-std::string squatter(const std::string& name) {
-  const std::string path = "/dev/shm" + name;
-  struct stat st {};
-  if (::lstat(path.c_str(), &st) != 0) return {};
-  const char* kind = S_ISLNK(st.st_mode)   ? "a symbolic link"
-                     : S_ISDIR(st.st_mode) ? "a directory"
-                     : S_ISREG(st.st_mode) ? "a file"
-                                           : "a special file";
-  if (S_ISREG(st.st_mode) && st.st_uid == ::geteuid()) return {};
-  const struct passwd* pw = ::getpwuid(st.st_uid);
-  return path + " is " + kind + " owned by uid " + std::to_string(st.st_uid) +
-         (pw != nullptr ? " (" + std::string(pw->pw_name) + ")" : std::string()) +
-         (S_ISREG(st.st_mode)
-              ? ", not by this daemon's user (uid " + std::to_string(::geteuid()) + ")"
-              : std::string(", not a shared-memory segment")) +
-         ": remove it (as its owner or root) or choose another ipc.shm_name";
-}
-
-// Creates `name` exclusively and locks it. An existing segment is replaced
-// only when no live writer holds its lock (flock is dropped by the kernel when
-// the owner dies, whatever the pid namespace).
-Result<UniqueFd> claim_name(const std::string& name, ShmErrc* code) {
-  UniqueFd fd;
-  for (int attempt = 0; attempt < kCreateAttempts && !fd.valid(); ++attempt) {
-    fd = UniqueFd(::shm_open(name.c_str(), O_RDWR | O_CREAT | O_EXCL | O_CLOEXEC, kSegmentMode));
-    if (fd.valid()) break;
-    const int e = errno;
-    if (e != EEXIST) {
-      return fail(code, shm::errc_from_errno(e),
-                  "cannot create shm segment " + name + " (mode " + shm::mode_text(kSegmentMode) +
-                      "): " + shm::errno_text(e));
-    }
-    if (const std::string taken = squatter(name); !taken.empty())
-      return fail(code, ShmErrc::kNameTaken, "cannot create shm segment " + name + ": " + taken);
-    UniqueFd old(::shm_open(name.c_str(), O_RDWR | O_CLOEXEC, 0));
-    if (!old.valid()) {
-      const int oe = errno;
-      if (oe == ENOENT) continue;  // removed meanwhile: try again
-      return fail(code, shm::errc_from_errno(oe),
-                  "shm segment " + name +
-                      " exists and cannot be opened to check its writer: " + shm::errno_text(oe));
-    }
-    if (::flock(old.get(), LOCK_EX | LOCK_NB) != 0) {
-      const int le = errno;
-      if (le == EWOULDBLOCK) {
-        const int pid = existing_writer_pid(old.get());
-        return fail(code, ShmErrc::kLiveWriter,
-                    "another ceilposed (pid " + (pid > 0 ? std::to_string(pid) : "unknown") +
-                        ") is publishing on " + name);
-      }
-      return fail(code, ShmErrc::kSystem,
-                  "cannot lock shm segment " + name + ": " + shm::errno_text(le));
-    }
-    // Its writer is gone: replace it. Unlink while holding its lock so a
-    // concurrent creator sees it as owned.
-    wake_readers_of(old.get());
-    if (::shm_unlink(name.c_str()) != 0 && errno != ENOENT) {
-      const int ue = errno;
-      return fail(code, shm::errc_from_errno(ue),
-                  "cannot remove stale shm segment " + name + ": " + shm::errno_text(ue));
-    }
-  }
-  if (!fd.valid()) {
-    return fail(code, ShmErrc::kLiveWriter,
-                "shm segment " + name + " keeps being re-created by another process");
-  }
-  // Between O_EXCL and this lock another creator could only see an empty,
-  // unlocked segment; it would replace it and our lock still wins on ours.
-  if (::flock(fd.get(), LOCK_EX | LOCK_NB) != 0) {
-    const int le = errno;
-    return fail(code, ShmErrc::kLiveWriter,
-                "cannot lock new shm segment " + name + ": " + shm::errno_text(le));
-  }
-  return fd;
-}
-
-// Sizes and maps a segment that `fd` holds.
-Result<Mapping> size_and_map(int fd, const std::string& name, size_t size_bytes, ShmErrc* code) {
-  if (::ftruncate(fd, static_cast<off_t>(size_bytes)) != 0) {
-    const int e = errno;
-    return fail(code, shm::errc_from_errno(e),
-                "cannot size shm segment " + name + " to " + std::to_string(size_bytes) +
-                    " bytes: " + shm::errno_text(e));
-  }
-  int map_error = 0;
-  Mapping mapping = shm::map_shared(fd, size_bytes, true, shm::OnShrink::kRegrow, &map_error);
-  if (mapping.get() == nullptr) {
-    return fail(code, shm::errc_from_errno(map_error),
-                "cannot map shm segment " + name + " (" + std::to_string(size_bytes) +
-                    " bytes): " + shm::errno_text(map_error));
-  }
-  return mapping;
-}
-
 // The companion "-wake" segment, complete (magic stored) before the main one.
 Result<void> create_wake_segment(const std::string& name, gid_t gid, uint64_t generation,
                                  UniqueFd* fd_out, Mapping* mapping_out, ShmErrc* code) {
   const std::string wake_name = shm::wake_segment_name(name);
-  if (const std::string taken = squatter(wake_name); !taken.empty())
+  if (const std::string taken = shm::squatter(wake_name); !taken.empty())
     return fail(code, ShmErrc::kNameTaken, "cannot create shm segment " + wake_name + ": " + taken);
   ::shm_unlink(wake_name.c_str());  // a stale one, if any; ENOENT is normal
   UniqueFd fd(::shm_open(wake_name.c_str(), O_RDWR | O_CREAT | O_EXCL | O_CLOEXEC, kWakeMode));
@@ -360,8 +236,9 @@ Result<void> create_wake_segment(const std::string& name, gid_t gid, uint64_t ge
                 "cannot create shm segment " + wake_name + " (mode " + shm::mode_text(kWakeMode) +
                     "): " + shm::errno_text(e));
   }
-  if (auto r = set_owner_and_mode(fd.get(), wake_name, kWakeMode, gid, code); !r) return r.error();
-  auto mapping = size_and_map(fd.get(), wake_name, sizeof(WakeSegment), code);
+  if (auto r = shm::set_owner_and_mode(fd.get(), wake_name, kWakeMode, gid, code); !r)
+    return r.error();
+  auto mapping = shm::size_and_map(fd.get(), wake_name, sizeof(WakeSegment), code);
   if (!mapping) return mapping.error();
   auto* wake = new (mapping->get()) WakeSegment();
   wake->generation = generation;
@@ -403,7 +280,7 @@ Result<ShmPoseWriter> ShmPoseWriter::create(const ShmOptions& options, ShmErrc* 
   if (auto ok = check_options(options, code); !ok) return ok.error();
   auto gid = shm::lookup_group(options.group, name, code);
   if (!gid) return gid.error();
-  auto fd = claim_name(name, code);
+  auto fd = shm::claim_name(name, kSegmentMode, kPoseSegmentHooks, code);
   if (!fd) return fd.error();
 
   // Until the segment is complete, any failure removes what was made.
@@ -417,15 +294,16 @@ Result<ShmPoseWriter> ShmPoseWriter::create(const ShmOptions& options, ShmErrc* 
     }
   } cleanup{&name};
 
-  if (auto r = set_owner_and_mode(fd->get(), name, kSegmentMode, *gid, code); !r) return r.error();
+  if (auto r = shm::set_owner_and_mode(fd->get(), name, kSegmentMode, *gid, code); !r)
+    return r.error();
   auto impl = std::make_unique<Impl>();
   impl->name = name;
-  const uint64_t generation = new_generation();
+  const uint64_t generation = shm::new_generation();
   if (auto r =
           create_wake_segment(name, *gid, generation, &impl->wake_fd, &impl->wake_mapping, code);
       !r)
     return r.error();
-  auto mapping = size_and_map(fd->get(), name, sizeof(Segment), code);
+  auto mapping = shm::size_and_map(fd->get(), name, sizeof(Segment), code);
   if (!mapping) return mapping.error();
 
   struct stat wake_st {};

@@ -209,7 +209,7 @@ bool inside(const FieldAddresses::Field& f, const S& module_options) {
 TEST(ConfigSchema, EveryKeyIsBoundToTheOptionsOfTheModuleThatUsesIt) {
   // One home per setting: a key's value lives in its module's own options
   // struct, which the module reads (pipeline's PipelineConfig, capture's
-  // SourceOptions and CaptureThreadOptions, ipc's ShmOptions and DdsOptions). The few keys
+  // SourceOptions and CaptureThreadOptions, ipc's ShmOptions, DdsOptions and FleetOptions). The few keys
   // ceilposed itself consumes are listed with where; a new key that is in
   // neither fails here until it is bound where it takes effect.
   ServiceConfig c = default_config();
@@ -235,7 +235,7 @@ TEST(ConfigSchema, EveryKeyIsBoundToTheOptionsOfTheModuleThatUsesIt) {
   for (const auto& f : v.fields) {
     const bool in_module = inside(f, c.pipeline) || inside(f, c.capture.device) ||
                            inside(f, c.capture.thread) || inside(f, c.ipc) ||
-                           inside(f, c.dds.publisher);
+                           inside(f, c.dds.publisher) || inside(f, c.fleet);
     EXPECT_TRUE(in_module || daemon_keys.count(f.key) == 1)
         << f.key << " is bound to no module's options";
   }

@@ -56,6 +56,7 @@ TEST(LiveKeys, AReloadTakesExactlyTheLiveKeysFromTheNewFile) {
                                         {"capture.fps", "15", "t"},
                                         {"ipc.stale_after_ms", "900", "t"},
                                         {"dds.domain_id", "7", "t"},
+                                        {"fleet.capacity", "300", "t"},
                                         {"logging.level", "debug", "t"},
                                         {"watchdog.max_stall_ms", "900", "t"}});
   ASSERT_TRUE(next.ok()) << next.error().message;

@@ -245,6 +245,94 @@ const char* ceilpose_refusal_name(unsigned index);
  * sets it, so an older failure never shows after a later call. */
 const char* ceilpose_last_error_message(void);
 
+/* ---- The fleet (SPEC §12) ------------------------------------------------
+ * ceilposed keeps every other robot's latest pose on its DDS domain in the
+ * segment "<shm>-fleet" (e.g. "/ceilpose-fleet"), one seqlocked slot per
+ * robot. A controller reads all of them, each carried to one instant:
+ *
+ *   ceilpose_fleet* f = NULL;
+ *   if (ceilpose_client_fleet_open("/ceilpose", &f) != CEILPOSE_OK) ...;
+ *   ceilpose_fleet_robot robots[64];
+ *   uint32_t n = 0;
+ *   ceilpose_client_fleet_read(f, now_mono_ns, robots, 64, &n);
+ *
+ * Lock-free and allocation-free after open, like ceilpose_client_predict. */
+
+/* Version of the fleet segment's layout; a reader refuses another one
+ * (CEILPOSE_ERR_ABI_MISMATCH). Independent of CEILPOSE_CLIENT_ABI_VERSION. */
+#define CEILPOSE_FLEET_ABI_VERSION 1
+/* Appended to the pose segment's name: "/ceilpose" -> "/ceilpose-fleet". */
+#define CEILPOSE_FLEET_SUFFIX "-fleet"
+/* Room for a robot name and its NUL (ROS name tokens are shorter). */
+#define CEILPOSE_ROBOT_NAME_SIZE 64
+
+/* ceilpose_fleet_robot.fleet_flags */
+#define CEILPOSE_FLEET_STALE 0x1u     /* nothing from it for fleet.stale_after_ms, or it left */
+#define CEILPOSE_FLEET_PREDICTED 0x2u /* pose carried to the instant asked for */
+/* Asked to predict, but it could not be: no motion state, or the instant is
+ * beyond its predict_horizon_ms (the pose is then as received). */
+#define CEILPOSE_FLEET_NOT_PREDICTED 0x4u
+
+/* One neighbour. pose.capture_mono_ns is its mid-exposure instant on THIS
+ * robot's CLOCK_MONOTONIC (its CLOCK_REALTIME stamp minus this robot's
+ * realtime-monotonic offset); pose.capture_real_ns is the stamp as sent. */
+typedef struct ceilpose_fleet_robot {
+  char robot[CEILPOSE_ROBOT_NAME_SIZE]; /* NUL-terminated ROS name */
+  ceilpose_pose pose;
+  int64_t received_mono_ns; /* when this robot received the sample */
+  /* Arrival minus exposure, both CLOCK_REALTIME, ns: transport delay plus the
+   * clock offset between the two robots (negative: its clock is ahead). */
+  int64_t latency_ns;
+  uint64_t samples;     /* samples accepted from it since it appeared */
+  uint32_t fleet_flags; /* CEILPOSE_FLEET_* */
+  uint32_t lost;        /* samples it sent that never arrived (gaps in pose.seq) */
+} ceilpose_fleet_robot;
+
+/* What the keeper of the segment counted; see docs/fleet.md. */
+typedef struct ceilpose_fleet_info {
+  int32_t pid;         /* the daemon writing the segment */
+  uint32_t state;      /* enum ceilpose_writer_state */
+  uint64_t generation; /* random per daemon start */
+  int64_t heartbeat_mono_ns;
+  uint32_t capacity;       /* slots (fleet.capacity) */
+  uint32_t robots;         /* slots in use now */
+  uint32_t stale_after_ms; /* fleet.stale_after_ms */
+  uint32_t reserved0;
+  uint64_t accepted;          /* samples written to a slot */
+  uint64_t refused_full;      /* samples of robots that found no free slot */
+  uint64_t refused_future;    /* stamped further ahead than fleet.max_clock_offset_ms */
+  uint64_t refused_past;      /* older than fleet.max_clock_offset_ms + stale_after_ms */
+  uint64_t refused_invalid;   /* non-finite or invalid pose, bad name */
+  uint64_t refused_duplicate; /* a second writer under a name already held */
+  uint64_t removed;           /* robots removed after going stale */
+} ceilpose_fleet_info;
+
+typedef struct ceilpose_fleet ceilpose_fleet;
+
+/* Opens "<shm>-fleet" for the pose segment name `shm` (NULL: "/ceilpose"),
+ * read-only, and checks magic, CEILPOSE_FLEET_ABI_VERSION and size. */
+int ceilpose_client_fleet_open(const char* shm, ceilpose_fleet** out);
+
+/* Unmaps and frees the handle. NULL is allowed. */
+void ceilpose_client_fleet_close(ceilpose_fleet* fleet);
+
+/* Copies up to max_robots neighbours into out, in slot order, and stores how
+ * many in *count. t_mono_ns != 0: each pose is carried to that instant
+ * (CLOCK_MONOTONIC) by the same model and horizon as ceilpose_client_predict,
+ * flag CEILPOSE_FLEET_PREDICTED, or CEILPOSE_FLEET_NOT_PREDICTED when it
+ * cannot be. t_mono_ns == 0: as received. A slot the writer kept rewriting
+ * during the read is skipped (it is read again on the next call). */
+int ceilpose_client_fleet_read(ceilpose_fleet* fleet, int64_t t_mono_ns, ceilpose_fleet_robot* out,
+                               uint32_t max_robots, uint32_t* count);
+
+/* One neighbour by name, as fleet_read would give it. CEILPOSE_ERR_NO_POSE
+ * when no slot holds that robot. */
+int ceilpose_client_fleet_find(ceilpose_fleet* fleet, const char* robot, int64_t t_mono_ns,
+                               ceilpose_fleet_robot* out);
+
+/* The keeper's identity and counters. */
+int ceilpose_client_fleet_info(ceilpose_fleet* fleet, ceilpose_fleet_info* out);
+
 /* Layout checks, so C and C++ compilers agree on the shared bytes. */
 #ifdef __cplusplus
 #define CEILPOSE_STATIC_ASSERT(c, m) static_assert(c, m)
@@ -265,6 +353,10 @@ CEILPOSE_STATIC_ASSERT(offsetof(ceilpose_status, refusals) == 176, "ceilpose_sta
 CEILPOSE_STATIC_ASSERT(offsetof(ceilpose_status, latency_p50_us) == 40, "status latency offset");
 CEILPOSE_STATIC_ASSERT(offsetof(ceilpose_status, updated_mono_ns) == 64, "status time offset");
 CEILPOSE_STATIC_ASSERT(offsetof(ceilpose_status, source) == 72, "ceilpose_status.source");
+CEILPOSE_STATIC_ASSERT(sizeof(ceilpose_fleet_robot) == 968, "ceilpose_fleet_robot layout");
+CEILPOSE_STATIC_ASSERT(offsetof(ceilpose_fleet_robot, pose) == 64, "fleet robot pose offset");
+CEILPOSE_STATIC_ASSERT(offsetof(ceilpose_fleet_robot, latency_ns) == 944, "fleet latency offset");
+CEILPOSE_STATIC_ASSERT(sizeof(ceilpose_fleet_info) == 96, "ceilpose_fleet_info layout");
 #undef CEILPOSE_STATIC_ASSERT
 
 #ifdef __cplusplus
