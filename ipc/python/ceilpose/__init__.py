@@ -8,10 +8,13 @@ nothing is compiled on install::
         pose = client.wait_next(timeout_s=1.0)   # the next frame's pose
         now = client.predict()                   # where the robot is now
         print(now.x_m, now.y_m, now.yaw_rad, now.vx_mps)
+        for name, other in client.fleet(time.monotonic_ns()).items():
+            print(name, other.x_m, other.y_m, other.age_ms, other.stale)
 
 Times are CLOCK_MONOTONIC nanoseconds, as time.monotonic_ns() gives them on
 Linux. Every failure raises CeilposeError with the C client's code, its name
-and its message (which names the segment). docs/ipc.md describes the segment.
+and its message (which names the segment). docs/ipc.md describes the segment,
+docs/fleet.md the fleet segment behind Client.fleet().
 """
 
 import ctypes
@@ -19,9 +22,11 @@ import ctypes.util
 import os
 import time
 
-__all__ = ["Client", "Pose", "CeilposeError", "ABI_VERSION", "DEFAULT_SHM"]
+__all__ = ["Client", "Pose", "FleetPose", "CeilposeError", "ABI_VERSION", "FLEET_ABI_VERSION",
+           "DEFAULT_SHM"]
 
 ABI_VERSION = 3
+FLEET_ABI_VERSION = 1
 DEFAULT_SHM = "/ceilpose"
 _SONAME = "libceilpose_client.so.3"
 _STATE = 9
@@ -30,6 +35,10 @@ _FLAG_VALID = 0x1
 _FLAG_FILTERED = 0x2
 _FLAG_COASTING = 0x4
 _FLAG_MOTION = 0x8
+_FLEET_STALE = 0x1
+_FLEET_PREDICTED = 0x2
+_ROBOT_NAME_SIZE = 64
+_INT64_MIN, _INT64_MAX = -2**63, 2**63 - 1
 
 _ERRORS = {
     -1: "INVALID_ARGUMENT", -2: "NOT_FOUND", -3: "PERMISSION", -4: "ABI_MISMATCH",
@@ -69,9 +78,56 @@ class _PoseRecord(ctypes.Structure):
     ]
 
 
+class _FleetRecord(ctypes.Structure):
+    """The bytes of ceilpose_fleet_robot."""
+
+    _fields_ = [
+        ("robot", ctypes.c_char * _ROBOT_NAME_SIZE),
+        ("pose", _PoseRecord),
+        ("received_mono_ns", ctypes.c_int64),
+        ("latency_ns", ctypes.c_int64),
+        ("samples", ctypes.c_uint64),
+        ("fleet_flags", ctypes.c_uint32),
+        ("lost", ctypes.c_uint32),
+    ]
+
+
+class _FleetInfo(ctypes.Structure):
+    """The bytes of ceilpose_fleet_info."""
+
+    _fields_ = [
+        ("pid", ctypes.c_int32),
+        ("state", ctypes.c_uint32),
+        ("generation", ctypes.c_uint64),
+        ("heartbeat_mono_ns", ctypes.c_int64),
+        ("capacity", ctypes.c_uint32),
+        ("robots", ctypes.c_uint32),
+        ("stale_after_ms", ctypes.c_uint32),
+        ("reserved0", ctypes.c_uint32),
+        ("accepted", ctypes.c_uint64),
+        ("refused_full", ctypes.c_uint64),
+        ("refused_future", ctypes.c_uint64),
+        ("refused_past", ctypes.c_uint64),
+        ("refused_invalid", ctypes.c_uint64),
+        ("refused_duplicate", ctypes.c_uint64),
+        ("removed", ctypes.c_uint64),
+    ]
+
+
 # The header's own layout checks, repeated: a mismatch must fail at import.
 if ctypes.sizeof(_PoseRecord) != 872 or _PoseRecord.state_covariance.offset != 192:
     raise ImportError("ceilpose: ctypes layout of ceilpose_pose does not match ABI 3")
+if ctypes.sizeof(_FleetRecord) != 968 or _FleetRecord.latency_ns.offset != 944 or \
+        ctypes.sizeof(_FleetInfo) != 96:
+    raise ImportError("ceilpose: ctypes layout of the fleet records does not match fleet ABI 1")
+
+
+def _instant(t_mono_ns, what):
+    """t_mono_ns as an int64, refusing what the C call cannot take."""
+    t = int(t_mono_ns)
+    if not _INT64_MIN <= t <= _INT64_MAX:
+        raise CeilposeError(-1, f"{what}: {t} ns is outside the 64-bit range of CLOCK_MONOTONIC")
+    return t
 
 
 class CeilposeError(Exception):
@@ -102,6 +158,12 @@ def _load_library():
         "ceilpose_client_wait_next": ([handle, ctypes.c_uint64, ctypes.c_int32, pose_p],
                                       ctypes.c_int),
         "ceilpose_client_predict": ([handle, ctypes.c_int64, pose_p], ctypes.c_int),
+        "ceilpose_client_fleet_open": ([ctypes.c_char_p, ctypes.POINTER(handle)], ctypes.c_int),
+        "ceilpose_client_fleet_close": ([handle], None),
+        "ceilpose_client_fleet_read": ([handle, ctypes.c_int64, ctypes.POINTER(_FleetRecord),
+                                        ctypes.c_uint32, ctypes.POINTER(ctypes.c_uint32)],
+                                       ctypes.c_int),
+        "ceilpose_client_fleet_info": ([handle, ctypes.POINTER(_FleetInfo)], ctypes.c_int),
         "ceilpose_strerror": ([ctypes.c_int], ctypes.c_char_p),
         "ceilpose_last_error_message": ([], ctypes.c_char_p),
         "ceilpose_mode_name": ([ctypes.c_uint8], ctypes.c_char_p),
@@ -166,12 +228,55 @@ class Pose:
                 f"vy_mps={self.vy_mps:.3f}, mode={self.mode!r}, markers={self.markers})")
 
 
+class FleetPose:
+    """Another robot's pose from this robot's fleet segment (SPEC §12).
+
+    timestamp_ns is its mid-exposure instant on THIS robot's CLOCK_MONOTONIC
+    (comparable with time.monotonic_ns()); age_ms how old the pose was when
+    read (or, predicted, how far it was carried); latency_ms arrival minus
+    exposure on the two robots' realtime clocks; stale True once nothing came
+    from it for the daemon's fleet.stale_after_ms; predicted True when it was
+    carried to the instant asked for."""
+
+    __slots__ = ("robot", "seq", "x_m", "y_m", "yaw_rad", "covariance", "has_motion", "vx_mps",
+                 "vy_mps", "yaw_rate_radps", "velocity_covariance", "mode", "markers",
+                 "timestamp_ns", "stamp_real_ns", "age_ms", "latency_ms", "stale", "predicted",
+                 "samples", "lost")
+
+    def __init__(self, r, now_mono_ns):
+        p = r.pose
+        self.robot = r.robot.decode(errors="replace")
+        self.seq = p.seq
+        self.x_m, self.y_m, self.yaw_rad = p.x_m, p.y_m, p.yaw_rad
+        self.covariance = tuple(p.covariance)
+        self.has_motion = bool(p.flags & _FLAG_MOTION)
+        self.vx_mps, self.vy_mps, self.yaw_rate_radps = p.vx_mps, p.vy_mps, p.yaw_rate_radps
+        self.velocity_covariance = tuple(
+            p.state_covariance[(3 + i) * _STATE + 3 + j] for i in range(3) for j in range(3))
+        self.mode = _lib.ceilpose_mode_name(p.mode).decode()
+        self.markers = p.markers
+        self.timestamp_ns = p.capture_mono_ns
+        self.stamp_real_ns = p.capture_real_ns
+        self.age_ms = (now_mono_ns - p.capture_mono_ns) / 1e6
+        self.latency_ms = r.latency_ns / 1e6
+        self.stale = bool(r.fleet_flags & _FLEET_STALE)
+        self.predicted = bool(r.fleet_flags & _FLEET_PREDICTED)
+        self.samples = r.samples
+        self.lost = r.lost
+
+    def __repr__(self):
+        return (f"FleetPose(robot={self.robot!r}, x_m={self.x_m:.4f}, y_m={self.y_m:.4f}, "
+                f"yaw_rad={self.yaw_rad:.4f}, age_ms={self.age_ms:.1f}, stale={self.stale})")
+
+
 class Client:
     """A reader of one pose segment. Not for concurrent use from several
     threads (open one Client per thread)."""
 
     def __init__(self, shm=DEFAULT_SHM):
         self._handle = ctypes.c_void_p()
+        self._fleet = ctypes.c_void_p()  # opened by the first fleet()
+        self._fleet_records = None
         self._record = _PoseRecord()
         self._last_seq = 0
         self.shm = shm
@@ -180,6 +285,9 @@ class Client:
             _raise(rc, f"cannot open the pose segment {shm}")
 
     def close(self):
+        if self._fleet:
+            _lib.ceilpose_client_fleet_close(self._fleet)
+            self._fleet = ctypes.c_void_p()
         if self._handle:
             _lib.ceilpose_client_close(self._handle)
             self._handle = ctypes.c_void_p()
@@ -222,11 +330,44 @@ class Client:
         filter: "where am I now". HORIZON beyond the daemon's
         filter.predict_horizon_ms, NO_MOTION without a filtered pose."""
         self._check_open()
-        t = time.monotonic_ns() if t_mono_ns is None else int(t_mono_ns)
+        t = time.monotonic_ns() if t_mono_ns is None else _instant(t_mono_ns, f"predict on {self.shm}")
         rc = _lib.ceilpose_client_predict(self._handle, t, ctypes.byref(self._record))
         if rc != 0:
             _raise(rc, f"cannot predict the pose on {self.shm} to {t} ns")
         return Pose(self._record)
+
+    def fleet(self, t_mono_ns=None):
+        """Every other robot the daemon keeps in "<shm>-fleet": a dict from
+        robot name to FleetPose, each carried to t_mono_ns (CLOCK_MONOTONIC)
+        by its own filter's motion when given (FleetPose.predicted says
+        whether it could be), else as received. NOT_FOUND when the daemon
+        keeps no fleet (fleet.enabled false, or DDS off)."""
+        self._check_open()
+        if not self._fleet:
+            rc = _lib.ceilpose_client_fleet_open(self.shm.encode(), ctypes.byref(self._fleet))
+            if rc != 0:
+                _raise(rc, f"cannot open the fleet segment of {self.shm}")
+            info = _FleetInfo()
+            _lib.ceilpose_client_fleet_info(self._fleet, ctypes.byref(info))
+            self._fleet_records = (_FleetRecord * info.capacity)()
+        t = 0 if t_mono_ns is None else _instant(t_mono_ns, f"fleet of {self.shm}")
+        count = ctypes.c_uint32()
+        rc = _lib.ceilpose_client_fleet_read(self._fleet, t, self._fleet_records,
+                                             len(self._fleet_records), ctypes.byref(count))
+        if rc != 0:
+            _raise(rc, f"cannot read the fleet segment of {self.shm}")
+        now = time.monotonic_ns()
+        return {p.robot: p for p in (FleetPose(self._fleet_records[i], now)
+                                     for i in range(count.value))}
+
+    def fleet_counters(self):
+        """The fleet keeper's counters: accepted and refused samples (full,
+        future, past, invalid, duplicate), removed robots, capacity."""
+        self.fleet()  # opens the segment if needed
+        info = _FleetInfo()
+        _lib.ceilpose_client_fleet_info(self._fleet, ctypes.byref(info))
+        return {name: getattr(info, name) for name, _ in _FleetInfo._fields_
+                if not name.startswith("reserved")}
 
     def _keep(self, pose):
         self._last_seq = pose.seq

@@ -122,11 +122,15 @@ class ClientWithoutDaemon(unittest.TestCase):
         for line in filter(None, out):
             name, *numbers = line.split()
             c_fields[name] = tuple(int(n) for n in numbers)
-        record = ceilpose._PoseRecord
-        self.assertEqual(c_fields.pop("sizeof"), (ctypes.sizeof(record),))
-        py_fields = {name: (getattr(record, name).offset, getattr(record, name).size)
-                     for name, _ in record._fields_}
-        self.assertEqual(py_fields, c_fields)
+        for prefix, record in (("", ceilpose._PoseRecord),
+                               ("fleet_robot.", ceilpose._FleetRecord),
+                               ("fleet_info.", ceilpose._FleetInfo)):
+            mine = {k[len(prefix):]: v for k, v in c_fields.items()
+                    if (k.startswith(prefix) if prefix else "." not in k)}
+            self.assertEqual(mine.pop("sizeof"), (ctypes.sizeof(record),), prefix)
+            py_fields = {name: (getattr(record, name).offset, getattr(record, name).size)
+                         for name, _ in record._fields_}
+            self.assertEqual(py_fields, mine, prefix)
 
 
 if __name__ == "__main__":
