@@ -31,11 +31,12 @@ struct MotionState {
 using JerkDensity = std::array<double, kMotionAxes>;
 
 // Propagates state x / covariance p (row-major kMotionStates²) by dt_s
-// seconds (either sign; the added noise grows with |dt|) into x_out / p_out,
-// which must not overlap the inputs. Only the first `orders` derivative
-// orders are written (1: pose, 2: pose and rates, 3: all); the rest of the
-// outputs is left as it was. The yaw is not wrapped. On raw arrays so that
-// the pose client carries a shared-memory record without copying it.
+// seconds (either sign; the added noise grows with |dt|) into x_out / p_out.
+// x_out must not overlap x; p_out may be p itself (P Fᵀ is taken whole into
+// a local before anything is written), which spares a controller a copy. Only the first `orders`
+// derivative orders are written (1: pose, 2: pose and rates, 3: all); the rest of the outputs is
+// left as it was. The yaw is not wrapped. On raw arrays so that the pose client carries a
+// shared-memory record without copying it.
 inline void propagate_motion(const double* x, const double* p, double dt_s, const JerkDensity& jerk,
                              double* x_out, double* p_out, int orders = kMotionOrders) {
   constexpr int A = kMotionAxes;
@@ -95,9 +96,12 @@ struct MotionEstimate {
 // rule for every consumer (the pose client, the filter's readout motion,
 // `locate --predict-ms`). In double: an int64 difference of arbitrary
 // instants cannot overflow it; NaN is never within.
+inline bool within_horizon(int64_t time_ns, double horizon_ms, int64_t t_ns) {
+  const double dt_ms = (static_cast<double>(t_ns) - static_cast<double>(time_ns)) * 1e-6;
+  return std::abs(dt_ms) <= horizon_ms;
+}
 inline bool within_horizon(const MotionEstimate& m, int64_t t_ns) {
-  const double dt_ms = (static_cast<double>(t_ns) - static_cast<double>(m.time_ns)) * 1e-6;
-  return std::abs(dt_ms) <= m.horizon_ms;
+  return within_horizon(m.time_ns, m.horizon_ms, t_ns);
 }
 
 // The estimate carried to t_ns: pose (yaw wrapped) and rates with their

@@ -58,28 +58,37 @@ MotionEstimate pose_motion(const PoseRecord& p) {
   return m;
 }
 
+PredictResult predict_pose_in_place(PoseRecord* pose, int64_t t_mono_ns) {
+  PoseRecord& p = *pose;
+  if ((p.flags & kPoseMotion) == 0 || !pose_is_valid(p)) return PredictResult::kNoMotion;
+  if (!within_horizon(p.capture_mono_ns, p.predict_horizon_ms, t_mono_ns))
+    return PredictResult::kBeyondHorizon;
+  // motion_at on the record's own arrays (no MotionEstimate copied in and
+  // out: a controller predicts every robot of the fleet each cycle).
+  const double x[kMotionStates] = {p.x_m,     p.y_m,     p.yaw_rad,
+                                   p.vx_mps,  p.vy_mps,  p.yaw_rate_radps,
+                                   p.ax_mps2, p.ay_mps2, p.yaw_accel_radps2};
+  double x_out[kMotionStates];
+  double* p_out = p.state_covariance;  // in place: propagate_motion allows it
+  const JerkDensity jerk{p.jerk_density[0], p.jerk_density[1], p.jerk_density[2]};
+  propagate_motion(x, p.state_covariance, static_cast<double>(t_mono_ns - p.capture_mono_ns) * 1e-9,
+                   jerk, x_out, p_out, 2);
+  p.x_m = x_out[0];
+  p.y_m = x_out[1];
+  p.yaw_rad = wrap_angle_rad(x_out[2]);
+  p.vx_mps = x_out[3];
+  p.vy_mps = x_out[4];
+  p.yaw_rate_radps = x_out[5];
+  for (int r = 0; r < 3; ++r)
+    for (int c = 0; c < 3; ++c) p.covariance[r * 3 + c] = p_out[r * kMotionStates + c];
+  return PredictResult::kOk;
+}
+
 PredictResult predict_pose(const PoseRecord& pose, int64_t t_mono_ns, PoseRecord* out) {
   *out = pose;
-  MotionState ahead;
-  switch (predict_motion(pose_motion(pose), t_mono_ns, &ahead)) {
-    case PredictOutcome::kNoMotion:
-      return PredictResult::kNoMotion;
-    case PredictOutcome::kBeyondHorizon:
-      return PredictResult::kBeyondHorizon;
-    case PredictOutcome::kOk:
-      break;
-  }
-  out->x_m = ahead.x[0];
-  out->y_m = ahead.x[1];
-  out->yaw_rad = ahead.x[2];
-  out->vx_mps = ahead.x[3];
-  out->vy_mps = ahead.x[4];
-  out->yaw_rate_radps = ahead.x[5];
-  std::copy(ahead.p.begin(), ahead.p.end(), out->state_covariance);
-  for (int r = 0; r < 3; ++r)
-    for (int c = 0; c < 3; ++c)
-      out->covariance[r * 3 + c] = out->state_covariance[r * kMotionStates + c];
-  return PredictResult::kOk;
+  const PredictResult r = predict_pose_in_place(out, t_mono_ns);
+  if (r != PredictResult::kOk) *out = pose;
+  return r;
 }
 
 void set_status_source(StatusRecord* status, const char* text) {

@@ -58,6 +58,9 @@ enum class PredictResult { kOk, kNoMotion, kBeyondHorizon };
 // `pose` carried to t_mono_ns (ceilpose_client_predict): pose, yaw, rates and
 // their covariance at that instant; *out is `pose` unchanged unless kOk.
 PredictResult predict_pose(const PoseRecord& pose, int64_t t_mono_ns, PoseRecord* out);
+// The same on the record itself (the fleet reader's, no copies); *pose is
+// unchanged unless kOk.
+PredictResult predict_pose_in_place(PoseRecord* pose, int64_t t_mono_ns);
 
 // Copies `text` into the status record's fixed source field, truncating and
 // always NUL-terminating.

@@ -26,9 +26,7 @@ void carry_to(FleetRecord* r, int64_t t_mono_ns, int64_t now_ns, int64_t stale_a
   r->fleet_flags &= ~(CEILPOSE_FLEET_PREDICTED | CEILPOSE_FLEET_NOT_PREDICTED);
   if (now_ns - r->received_mono_ns > stale_after_ns) r->fleet_flags |= CEILPOSE_FLEET_STALE;
   if (t_mono_ns == 0) return;
-  PoseRecord predicted;
-  if (predict_pose(r->pose, t_mono_ns, &predicted) == PredictResult::kOk) {
-    r->pose = predicted;
+  if (predict_pose_in_place(&r->pose, t_mono_ns) == PredictResult::kOk) {
     r->fleet_flags |= CEILPOSE_FLEET_PREDICTED;
   } else {
     r->fleet_flags |= CEILPOSE_FLEET_NOT_PREDICTED;
@@ -37,7 +35,7 @@ void carry_to(FleetRecord* r, int64_t t_mono_ns, int64_t now_ns, int64_t stale_a
 
 bool load_slot(const shm::FleetSlot& slot, FleetRecord* out) {
   for (int i = 0; i < kSlotRetries; ++i) {
-    if (slot.try_load(out)) return true;
+    if (slot.try_load_in_place(out)) return true;
   }
   return false;
 }

@@ -71,6 +71,21 @@ struct alignas(64) SeqlockSlot {
     seq.store(s + 2, std::memory_order_release);
   }
 
+  // One attempt straight into *out, which holds a torn copy when it returns
+  // false: for readers that retry into the same place anyway (the fleet's
+  // snapshot), one copy of the payload instead of two.
+  bool try_load_in_place(T* out) const {
+    const uint32_t s0 = seq.load(std::memory_order_acquire);
+    if ((s0 & 1u) != 0) return false;
+    auto* bytes = reinterpret_cast<unsigned char*>(out);
+    for (size_t i = 0; i < kWords; ++i) {
+      const uint64_t w = words[i].load(std::memory_order_relaxed);
+      std::memcpy(bytes + i * sizeof(uint64_t), &w, sizeof w);
+    }
+    std::atomic_thread_fence(std::memory_order_acquire);
+    return seq.load(std::memory_order_relaxed) == s0;
+  }
+
   // One attempt; false when a write overlapped (the caller retries).
   bool try_load(T* out) const {
     const uint32_t s0 = seq.load(std::memory_order_acquire);
