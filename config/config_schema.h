@@ -55,6 +55,17 @@ inline const char* check_no_space(const std::string& s) {
   return "a name without spaces or '/'";
 }
 
+// A TF frame id: what tf2 accepts and the DDS options can carry.
+inline const char* check_frame_name(const std::string& s) {
+  if (s.size() > 255) return "a frame name of at most 255 characters";
+  for (char ch : s) {
+    if (ch == ' ' || ch == '"' || ch == '\'' || ch == '<' || ch == '>' || ch == '&' || ch == ',' ||
+        static_cast<unsigned char>(ch) < 0x20)
+      return "a frame name without spaces, quotes, commas or <>&";
+  }
+  return nullptr;
+}
+
 inline constexpr double kPi = std::numbers::pi;
 
 // Sections SIGHUP applies live (is_live_key), and the keys in them that
@@ -260,6 +271,12 @@ void describe(V& v, ServiceConfig& c) {
     v.texts("interfaces", o.domain.interfaces, &check_no_space);
     v.texts("peers", o.domain.peers, &check_no_space);
     v.field("status_period_ms", d.status_period_ms, 10, 60'000);
+    v.section("tf", [&] {
+      v.field("enabled", o.rviz.tf);
+      v.text("parent_frame", o.rviz.tf_parent_frame, &check_frame_name);
+      v.text("child_frame", o.rviz.tf_child_frame, &check_frame_name);
+    });
+    v.field("ceiling_markers", o.rviz.ceiling);
     v.section("security", [&] {
       v.text("keystore", d.security.keystore_dir, &check_any_text);
       v.text("enclave", d.security.enclave, &check_robot_name);

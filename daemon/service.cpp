@@ -238,6 +238,16 @@ int Service::start_dds() {
     return kExitFailure;
   }
   dds_.emplace(std::move(pub).value());
+  if (!dds_->rviz_problem().empty())
+    spdlog::warn(
+        "DDS: {} not published: {} (an enclave made before ceilpose published them "
+        "needs `ceilposectl keys add` again)",
+        dds_->publishes_tf() ? "the ceiling is" : "TF (and maybe the ceiling) is",
+        dds_->rviz_problem());
+  const PipelineConfig& running = running_config(config_).pipeline;
+  const CeilingMap nominal(running.layout);
+  if (auto ok = dds_->publish_ceiling(running.layout, running.map ? *running.map : nominal); !ok)
+    spdlog::warn("DDS: {}", ok.error().message);
   dds_sink_.emplace(&*dds_, config_.dds.status_period_ms);
   sinks_.push_back(&*dds_sink_);
   spdlog::info("DDS: domain {} topic {}, status every {} ms", dds_->domain_id(), dds_->pose_topic(),

@@ -111,6 +111,10 @@ std::string permissions_xml(const std::string& robot, std::time_t not_before,
          "            <topic>" +
          publish_topic_pattern(robot) +
          "</topic>\n"
+         // ROS has one TF topic for every robot (rt/tf): any robot of the
+         // fleet may publish on it. TF is for viewers; controllers read the
+         // fleet from rt/<robot>/ceilpose_state, which only <robot> may write.
+         "            <topic>rt/tf</topic>\n"
          "          </topics>\n"
          "        </publish>\n"
          "        <subscribe>\n"

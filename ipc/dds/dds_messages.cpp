@@ -135,6 +135,23 @@ void to_message(const DdsStatus& status, const std::string& robot, ceilpose_msg_
     msg->refusals[i] = i < status.refusals.size() ? status.refusals[i] : 0;
 }
 
+void to_message(const DdsPose& pose, const char* parent, const char* child,
+                geometry_msgs_msg_dds__TransformStamped_* storage,
+                tf2_msgs_msg_dds__TFMessage_* msg) {
+  geometry_msgs_msg_dds__PoseWithCovarianceStamped_ stamped;
+  to_message(pose, &stamped);  // one place turns a pose into position + quaternion
+  storage->header.stamp = stamped.header.stamp;
+  storage->header.frame_id = const_cast<char*>(parent);
+  storage->child_frame_id = const_cast<char*>(child);
+  const auto& p = stamped.pose.pose;
+  storage->transform.translation = {p.position.x, p.position.y, p.position.z};
+  storage->transform.rotation = p.orientation;
+  msg->transforms._maximum = 1;
+  msg->transforms._length = 1;
+  msg->transforms._buffer = storage;
+  msg->transforms._release = false;
+}
+
 void to_message(const PoseRecord& pose, ceilpose_msg_dds__State_* msg) {
   msg->header.stamp = to_time(pose.capture_real_ns);
   msg->header.frame_id = const_cast<char*>(kMapFrame);

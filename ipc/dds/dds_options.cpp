@@ -35,6 +35,15 @@ std::string state_topic_name(std::string_view robot) {
   return "rt/" + std::string(robot) + "/ceilpose_state";
 }
 
+std::string ceiling_topic_name(std::string_view robot) {
+  return "rt/" + std::string(robot) + "/ceiling";
+}
+
+std::string tf_child_frame(const DdsOptions& options) {
+  return options.rviz.tf_child_frame.empty() ? options.robot + "/base_link"
+                                             : options.rviz.tf_child_frame;
+}
+
 std::string robot_from_topic(std::string_view topic, std::string_view suffix) {
   constexpr std::string_view kPrefix = "rt/";
   if (topic.size() <= kPrefix.size() + suffix.size() || !topic.starts_with(kPrefix) ||
@@ -79,6 +88,14 @@ Result<void> validate(const DdsOptions& options) {
                       "with a digit); e.g. '" +
                       to_ros_name(options.robot) + "'");
   }
+  for (const std::string* frame : {&options.rviz.tf_parent_frame, &options.rviz.tf_child_frame}) {
+    if (frame->empty()) continue;  // the parent is checked below; an empty child is the default
+    if (!is_plain_xml_value(*frame) || frame->size() > 255) {
+      return make_error("TF frame '" + *frame +
+                        "' must be at most 255 characters without spaces, quotes or <>&,");
+    }
+  }
+  if (options.rviz.tf_parent_frame.empty()) return make_error("TF parent frame must not be empty");
   if (options.history_depth < 1) {
     return make_error("DDS history depth " + std::to_string(options.history_depth) +
                       " must be at least 1");

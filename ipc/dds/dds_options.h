@@ -48,6 +48,14 @@ struct DdsDomainOptions {
 
 enum class DdsReliability : uint8_t { kReliable, kBestEffort };
 
+// What RViz needs without glue (SPEC §12): every pose as TF, and the ceiling.
+struct DdsRvizOptions {
+  bool tf = true;  // rt/tf: parent_frame -> child_frame per pose
+  std::string tf_parent_frame = "map";
+  std::string tf_child_frame;  // "" = "<robot>/base_link"
+  bool ceiling = true;         // rt/<robot>/ceiling, transient local
+};
+
 struct DdsOptions {
   // ROS name token: the namespace of the topics rt/<robot>/pose and
   // rt/<robot>/ceilpose_status. Must satisfy is_valid_ros_name().
@@ -57,6 +65,7 @@ struct DdsOptions {
   // writer serves both reliable and best-effort readers, the reverse is not true.
   DdsReliability reliability = DdsReliability::kReliable;
   int32_t history_depth = 10;  // keep-last depth of the writers, >= 1
+  DdsRvizOptions rviz;
 };
 
 // is_valid_ros_name() and to_ros_name(): core/ros_name.h.
@@ -67,6 +76,12 @@ std::string odom_topic_name(std::string_view robot);    // "rt/<robot>/odom"
 
 // rt/<robot>/ceilpose_state: the full state the fleet keeps (SPEC §12).
 std::string state_topic_name(std::string_view robot);
+// rt/<robot>/ceiling: the ceiling as visualization_msgs/MarkerArray.
+std::string ceiling_topic_name(std::string_view robot);
+// ROS's one TF topic, shared by every robot.
+inline constexpr char kTfTopic[] = "rt/tf";
+// The TF child frame of `options`: tf_child_frame, or "<robot>/base_link".
+std::string tf_child_frame(const DdsOptions& options);
 
 // For a DDS topic name rt/<robot><suffix> returns <robot> if it is a valid
 // ROS name, else empty.

@@ -4,6 +4,8 @@
 #include <array>
 #include <cstring>
 
+#include "core/clock.h"
+#include "ipc/dds/dds_ceiling_markers.h"
 #include "ipc/dds/dds_error.h"
 #include "ipc/dds/dds_qos.h"
 
@@ -15,9 +17,12 @@ namespace {
 // next frame.
 constexpr int64_t kMaxBlockingMs = 10;
 
+enum class Durability { kVolatile, kTransientLocal };
+
 Result<dds_entity_t> create_writer(const DdsParticipant& participant,
                                    const dds_topic_descriptor_t* descriptor,
-                                   const std::string& topic_name, const DdsOptions& options) {
+                                   const std::string& topic_name, const DdsOptions& options,
+                                   Durability durability = Durability::kVolatile) {
   const std::string where =
       "DDS topic " + topic_name + " on domain " + std::to_string(participant.domain_id());
   const dds_entity_t topic =
@@ -30,8 +35,14 @@ Result<dds_entity_t> create_writer(const DdsParticipant& participant,
   } else {
     dds_qset_reliability(qos.get(), DDS_RELIABILITY_BEST_EFFORT, 0);
   }
-  dds_qset_history(qos.get(), DDS_HISTORY_KEEP_LAST, options.history_depth);
-  dds_qset_durability(qos.get(), DDS_DURABILITY_VOLATILE);
+  if (durability == Durability::kTransientLocal) {
+    // Late joiners (RViz started after the daemon) get the last sample.
+    dds_qset_history(qos.get(), DDS_HISTORY_KEEP_LAST, 1);
+    dds_qset_durability(qos.get(), DDS_DURABILITY_TRANSIENT_LOCAL);
+  } else {
+    dds_qset_history(qos.get(), DDS_HISTORY_KEEP_LAST, options.history_depth);
+    dds_qset_durability(qos.get(), DDS_DURABILITY_VOLATILE);
+  }
   // ROS 2 Humble/Iron and other vendors' ROS readers only speak XCDR1
   // (PLAIN_CDR); say so explicitly rather than rely on Cyclone's choice.
   const dds_data_representation_id_t xcdr1 = DDS_DATA_REPRESENTATION_XCDR1;
@@ -73,6 +84,28 @@ Result<DdsPosePublisher> DdsPosePublisher::create(const DdsOptions& options) {
       create_writer(pub.participant_, &ceilpose_msg_dds__State__desc, pub.state_topic_, options);
   if (!state_writer) return state_writer.error();
   pub.state_writer_ = *state_writer;
+  pub.ceiling_topic_ = ceiling_topic_name(options.robot);
+  pub.tf_parent_ = options.rviz.tf_parent_frame;
+  pub.tf_child_ = tf_child_frame(options);
+  // Optional: without them every robot still localizes and shares its pose.
+  if (options.rviz.tf) {
+    auto tf =
+        create_writer(pub.participant_, &tf2_msgs_msg_dds__TFMessage__desc, kTfTopic, options);
+    if (tf) {
+      pub.tf_writer_ = *tf;
+    } else {
+      pub.rviz_problem_ = tf.error().message;
+    }
+  }
+  if (options.rviz.ceiling) {
+    auto ceiling = create_writer(pub.participant_, &visualization_msgs_msg_dds__MarkerArray__desc,
+                                 pub.ceiling_topic_, options, Durability::kTransientLocal);
+    if (ceiling) {
+      pub.ceiling_writer_ = *ceiling;
+    } else {
+      pub.rviz_problem_ += (pub.rviz_problem_.empty() ? "" : "; ") + ceiling.error().message;
+    }
+  }
   pub.publication_reader_ = dds_create_reader(pub.participant_.handle(),
                                               DDS_BUILTIN_TOPIC_DCPSPUBLICATION, nullptr, nullptr);
   if (pub.publication_reader_ < 0) {
@@ -132,6 +165,14 @@ Result<void> DdsPosePublisher::publish(const DdsPose& pose) {
   to_message(pose, &odom);
   rc = dds_write(odom_writer_, &odom);
   if (rc != DDS_RETCODE_OK) return dds_error("cannot write odometry to " + odom_topic_, rc);
+  if (tf_writer_ > 0) {
+    geometry_msgs_msg_dds__TransformStamped_ transform;
+    tf2_msgs_msg_dds__TFMessage_ tf;
+    to_message(pose, tf_parent_.c_str(), tf_child_.c_str(), &transform, &tf);
+    rc = dds_write(tf_writer_, &tf);
+    if (rc != DDS_RETCODE_OK)
+      return dds_error(std::string("cannot write a transform to ") + kTfTopic, rc);
+  }
   ++published_;
   return {};
 }
@@ -142,6 +183,15 @@ Result<void> DdsPosePublisher::publish_status(const DdsStatus& status) {
   to_message(status, robot_, &msg);
   const dds_return_t rc = dds_write(status_writer_, &msg);
   if (rc != DDS_RETCODE_OK) return dds_error("cannot write a status to " + status_topic_, rc);
+  return {};
+}
+
+Result<void> DdsPosePublisher::publish_ceiling(const CeilingLayout& layout, const CeilingMap& map) {
+  if (!participant_.valid()) return make_error("DDS publisher of " + robot_ + " was disposed");
+  if (ceiling_writer_ <= 0) return {};
+  const CeilingMarkers markers(layout, map, realtime_ns());
+  const dds_return_t rc = dds_write(ceiling_writer_, &markers.message());
+  if (rc != DDS_RETCODE_OK) return dds_error("cannot write the ceiling to " + ceiling_topic_, rc);
   return {};
 }
 
@@ -162,6 +212,8 @@ void DdsPosePublisher::dispose() {
   status_writer_ = 0;
   odom_writer_ = 0;
   state_writer_ = 0;
+  tf_writer_ = 0;
+  ceiling_writer_ = 0;
   publication_reader_ = 0;
   other_writers_.clear();
 }

@@ -15,6 +15,8 @@
 #include <string>
 #include <vector>
 
+#include "core/ceiling_layout.h"
+#include "core/ceiling_map.h"
 #include "core/result.h"
 #include "ipc/dds/dds_messages.h"
 #include "ipc/dds/dds_options.h"
@@ -34,6 +36,9 @@ class DdsPosePublisher {
   // callers publish valid poses only, and the status topic reports no fix.
   Result<void> publish(const DdsPose& pose);
   Result<void> publish_status(const DdsStatus& status);
+  // The ceiling for RViz on rt/<robot>/ceiling (transient local: a viewer
+  // that starts later still gets it). Once at start; not per frame.
+  Result<void> publish_ceiling(const CeilingLayout& layout, const CeilingMap& map);
   // The full state (pose, motion, covariances) on rt/<robot>/ceilpose_state
   // for the other robots' fleet segments; valid poses only, like publish().
   Result<void> publish_state(const PoseRecord& pose);
@@ -47,6 +52,12 @@ class DdsPosePublisher {
   const std::string& status_topic() const { return status_topic_; }
   const std::string& odom_topic() const { return odom_topic_; }
   const std::string& state_topic() const { return state_topic_; }
+  const std::string& ceiling_topic() const { return ceiling_topic_; }
+  // Why TF or the ceiling is not published although configured (their
+  // writers are optional: access control of an enclave made before they
+  // existed refuses them); empty when all is well.
+  const std::string& rviz_problem() const { return rviz_problem_; }
+  bool publishes_tf() const { return tf_writer_ > 0; }
   uint32_t domain_id() const { return participant_.domain_id(); }
   // For entities that should share this participant (one participant per
   // process is the cheapest for discovery); 0 after dispose().
@@ -67,11 +78,17 @@ class DdsPosePublisher {
   dds_entity_t status_writer_ = 0;
   dds_entity_t odom_writer_ = 0;
   dds_entity_t state_writer_ = 0;
+  dds_entity_t tf_writer_ = 0;       // 0: TF off or refused
+  dds_entity_t ceiling_writer_ = 0;  // 0: ceiling off or refused
+  std::string tf_parent_;
+  std::string tf_child_;
+  std::string rviz_problem_;
   std::string robot_;
   std::string pose_topic_;
   std::string status_topic_;
   std::string odom_topic_;
   std::string state_topic_;
+  std::string ceiling_topic_;
   uint64_t published_ = 0;
   dds_entity_t publication_reader_ = 0;  // DCPSPublication, child of participant_
   dds_guid_t own_guid_{};

@@ -97,12 +97,14 @@ TEST_F(KeystoreTest, TheOpensslCommandVerifiesCertificatesAndSignedDocuments) {
 TEST_F(KeystoreTest, PermissionsLetARobotPublishOnlyItsOwnTopicsAndReadEveryRobotsPose) {
   const std::string xml = slurp(layout().permissions_xml("r1"));
   EXPECT_NE(xml.find("<subject_name>CN=r1</subject_name>"), std::string::npos);
+  // Its own topics, and ROS's one TF topic (which every robot shares).
   EXPECT_NE(xml.find("<publish>\n          <topics>\n            <topic>rt/r1/*</topic>\n"
-                     "          </topics>\n        </publish>"),
+                     "            <topic>rt/tf</topic>\n          </topics>\n        </publish>"),
             std::string::npos)
       << xml;
   EXPECT_NE(xml.find("<topic>rt/*/pose</topic>"), std::string::npos);
   EXPECT_NE(xml.find("<topic>rt/*/ceilpose_status</topic>"), std::string::npos);
+  EXPECT_NE(xml.find("<topic>rt/*/ceilpose_state</topic>"), std::string::npos) << "the fleet";
   EXPECT_NE(xml.find("<default>DENY</default>"), std::string::npos);
   const std::string governance = slurp(layout().governance_xml());
   for (const char* rule :

@@ -107,5 +107,57 @@ TEST(DdsInterop, FastDdsSubscriberDecodesPublishedOdometry) {
   EXPECT_NE(line.find(cov), std::string::npos) << line << "\nexpected " << cov;
 }
 
+// Issue 26: RViz without glue. Every pose as tf2_msgs/TFMessage on rt/tf,
+// map -> <robot>/base_link, every field decoded by another vendor.
+TEST(DdsInterop, FastDdsSubscriberDecodesTheTransformOfEveryPose) {
+  test::use_loopback_dds();
+  const std::string domain = std::to_string(test::unique_domain_id());
+  const std::string robot = test::unique_robot_name("tf");
+  ChildProcess publisher(fake_robot(robot, domain, {}));
+  ASSERT_NE(publisher.read_until("ready", kTimeoutMs).find("ready"), std::string::npos);
+  ChildProcess subscriber({CEILPOSE_FASTDDS_LISTENER, "--domain", domain, "--topic", "rt/tf",
+                           "--type", "tf", "--count", "2", "--timeout-ms", "15000"});
+  ASSERT_EQ(subscriber.wait_exit(kTimeoutMs), 0) << subscriber.output();
+  const std::string& out = subscriber.output();
+  const std::string expected =
+      "tf transforms=1 | sec=1700000000 nanosec=123456789 parent=map "
+      "child=" +
+      robot +
+      "/base_link x=1.25 y=-0.5 z=0 qx=0 qy=0 "
+      "qz=0.247403959 qw=0.968912422";
+  EXPECT_NE(out.find(expected), std::string::npos) << out << "\nexpected " << expected;
+}
+
+// The ceiling as visualization_msgs/MarkerArray on rt/<robot>/ceiling,
+// published once at start and transient local: a viewer that starts later
+// still gets it. The nominal 8 x 8 grid of the default layout: the red and
+// the green rectangles as two CUBE_LISTs of 64, then 64 labels "i,j".
+TEST(DdsInterop, ALateFastDdsViewerGetsTheCeilingWithEveryField) {
+  test::use_loopback_dds();
+  const std::string domain = std::to_string(test::unique_domain_id());
+  const std::string robot = test::unique_robot_name("ceil");
+  ChildProcess publisher(fake_robot(robot, domain, {}));
+  ASSERT_NE(publisher.read_until("ready", kTimeoutMs).find("ready"), std::string::npos);
+  ChildProcess subscriber({CEILPOSE_FASTDDS_LISTENER, "--domain", domain, "--topic",
+                           "rt/" + robot + "/ceiling", "--type", "markers", "--count", "1",
+                           "--timeout-ms", "15000"});
+  ASSERT_EQ(subscriber.wait_exit(kTimeoutMs), 0) << subscriber.output();
+  const std::string& out = subscriber.output();
+  EXPECT_NE(out.find("markers count=66 | "), std::string::npos) << out;
+  EXPECT_NE(out.find("frame=map"), std::string::npos);
+  // Red rectangles: 5 x 12 in at marker centre + 2.5 in east, on the 2.4384 m ceiling.
+  EXPECT_NE(out.find("ns=ceiling id=0 type=6 action=0 x=0 y=0 z=0 qw=1 scale=0.127,0.3048,0.002 "
+                     "rgba=0.784,0.118,0.157,1 lifetime=0 frame_locked=0 points=64 "
+                     "first=0.0635,0,2.4384 colors=0 texture= uv=0 text= mesh= embedded=0"),
+            std::string::npos)
+      << out.substr(0, 2000);
+  EXPECT_NE(out.find("ns=ceiling id=1 type=6 action=0"), std::string::npos);
+  EXPECT_NE(out.find("points=64 first=-0.0635,0,2.4384"), std::string::npos) << "green";
+  EXPECT_NE(out.find("ns=ceiling_codes id=63 type=9 action=0 x=4.2672 y=4.2672 z=2.3884"),
+            std::string::npos)
+      << "the last label, under marker (7, 7)";
+  EXPECT_NE(out.find("text=7,7 "), std::string::npos);
+}
+
 }  // namespace
 }  // namespace ceilpose

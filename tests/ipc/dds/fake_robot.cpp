@@ -65,6 +65,12 @@ int main(int argc, char** argv) {
     std::cerr << "ceilpose_dds_fake_robot: " << publisher.error().message << "\n";
     return 1;
   }
+  // The nominal ceiling of the default layout, for RViz (rt/<robot>/ceiling).
+  const CeilingLayout layout;
+  if (auto ok = publisher->publish_ceiling(layout, CeilingMap(layout)); !ok) {
+    std::cerr << "ceilpose_dds_fake_robot: " << ok.error().message << "\n";
+    return 1;
+  }
   std::printf("ready %s\n", publisher->pose_topic().c_str());
   std::fflush(stdout);
 

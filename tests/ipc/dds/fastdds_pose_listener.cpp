@@ -13,6 +13,7 @@
 #include <unistd.h>
 
 #include <chrono>
+#include <cstdarg>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
@@ -28,6 +29,7 @@
 #include <string>
 #include <thread>
 #include <utility>
+#include <vector>
 
 namespace {
 
@@ -48,6 +50,29 @@ struct PoseMsg {
   double angular[3] = {};
   double twist_covariance[36] = {};
 };
+
+// Decodes one sample with `read` (the fields in rosidl's order), failing it
+// when a field is missing or bytes are left over (CDR pads the end to 4
+// bytes at most).
+template <typename Read>
+bool decode_payload(frtps::SerializedPayload_t* payload, Read&& read) {
+  eprosima::fastcdr::FastBuffer buffer(reinterpret_cast<char*>(payload->data), payload->length);
+  eprosima::fastcdr::Cdr cdr(buffer, eprosima::fastcdr::Cdr::DEFAULT_ENDIAN,
+                             eprosima::fastcdr::Cdr::DDS_CDR);
+  try {
+    cdr.read_encapsulation();
+    read(cdr);
+    if (payload->length - cdr.getSerializedDataLength() >= 4) {
+      std::fprintf(stderr, "fastdds listener: %zu bytes left over in a sample\n",
+                   payload->length - cdr.getSerializedDataLength());
+      return false;
+    }
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "fastdds listener: cannot decode a sample: %s\n", e.what());
+    return false;
+  }
+  return true;
+}
 
 class PoseType : public fdds::TopicDataType {
  public:
@@ -82,11 +107,7 @@ class PoseType : public fdds::TopicDataType {
 
   bool deserialize(frtps::SerializedPayload_t* payload, void* data) override {
     auto* msg = static_cast<PoseMsg*>(data);
-    eprosima::fastcdr::FastBuffer buffer(reinterpret_cast<char*>(payload->data), payload->length);
-    eprosima::fastcdr::Cdr cdr(buffer, eprosima::fastcdr::Cdr::DEFAULT_ENDIAN,
-                               eprosima::fastcdr::Cdr::DDS_CDR);
-    try {
-      cdr.read_encapsulation();
+    return decode_payload(payload, [&](eprosima::fastcdr::Cdr& cdr) {
       cdr >> msg->sec >> msg->nanosec >> msg->frame_id;
       if (odom_) cdr >> msg->child_frame_id;
       cdr.deserializeArray(msg->position, 3);
@@ -97,16 +118,7 @@ class PoseType : public fdds::TopicDataType {
         cdr.deserializeArray(msg->angular, 3);
         cdr.deserializeArray(msg->twist_covariance, 36);
       }
-      if (cdr.getSerializedDataLength() != payload->length) {
-        std::fprintf(stderr, "fastdds listener: %zu bytes left over in a sample\n",
-                     payload->length - cdr.getSerializedDataLength());
-        return false;
-      }
-    } catch (const std::exception& e) {
-      std::fprintf(stderr, "fastdds listener: cannot decode a sample: %s\n", e.what());
-      return false;
-    }
-    return true;
+    });
   }
 
   std::function<uint32_t()> getSerializedSizeProvider(void*) override {
@@ -120,6 +132,131 @@ class PoseType : public fdds::TopicDataType {
   bool odom_;
 };
 
+// Reads what every ROS message starts with: std_msgs/Header.
+void read_header(eprosima::fastcdr::Cdr& cdr, int32_t* sec, uint32_t* nanosec,
+                 std::string* frame_id) {
+  cdr >> *sec >> *nanosec >> *frame_id;
+}
+
+// A by-hand decoder: `decode` reads every field of one sample into `text`
+// (what main prints), in the order rosidl lays them out; any field missing
+// or left over fails the sample.
+class DecodedType : public fdds::TopicDataType {
+ public:
+  using Decode = void (*)(eprosima::fastcdr::Cdr& cdr, std::string* text);
+  DecodedType(const char* name, Decode decode) : decode_(decode) {
+    setName(name);
+    m_typeSize = 4 + (1u << 20);  // the ceiling of a 256-marker grid fits
+    m_isGetKeyDefined = false;
+  }
+  bool serialize(void*, frtps::SerializedPayload_t*) override { return false; }  // read only
+  bool deserialize(frtps::SerializedPayload_t* payload, void* data) override {
+    auto* text = static_cast<std::string*>(data);
+    return decode_payload(payload, [&](eprosima::fastcdr::Cdr& cdr) { decode_(cdr, text); });
+  }
+  std::function<uint32_t()> getSerializedSizeProvider(void*) override {
+    return [] { return 4u + (1u << 20); };
+  }
+  void* createData() override { return new std::string(); }
+  void deleteData(void* data) override { delete static_cast<std::string*>(data); }
+  bool getKey(void*, frtps::InstanceHandle_t*, bool) override { return false; }
+
+ private:
+  Decode decode_;
+};
+
+std::string fmt(const char* format, ...) __attribute__((format(printf, 1, 2)));
+std::string fmt(const char* format, ...) {
+  char text[1024];
+  va_list args;
+  va_start(args, format);
+  std::vsnprintf(text, sizeof text, format, args);
+  va_end(args);
+  return text;
+}
+
+// tf2_msgs/TFMessage: geometry_msgs/TransformStamped[] transforms.
+void decode_tf(eprosima::fastcdr::Cdr& cdr, std::string* text) {
+  uint32_t n = 0;
+  cdr >> n;
+  *text = fmt("tf transforms=%u", n);
+  for (uint32_t k = 0; k < n; ++k) {
+    int32_t sec = 0;
+    uint32_t nanosec = 0;
+    std::string parent, child;
+    read_header(cdr, &sec, &nanosec, &parent);
+    cdr >> child;
+    double t[3], q[4];
+    cdr.deserializeArray(t, 3);
+    cdr.deserializeArray(q, 4);
+    *text +=
+        fmt(" | sec=%d nanosec=%u parent=%s child=%s x=%.9g y=%.9g z=%.9g qx=%.9g qy=%.9g "
+            "qz=%.9g qw=%.9g",
+            sec, nanosec, parent.c_str(), child.c_str(), t[0], t[1], t[2], q[0], q[1], q[2], q[3]);
+  }
+}
+
+// visualization_msgs/MarkerArray: Marker[] markers, each field of Humble's
+// Marker.msg in order. Prints the count, then per marker its identity,
+// pose, scale, colour, the number of points and the first, and the text.
+void decode_markers(eprosima::fastcdr::Cdr& cdr, std::string* text) {
+  uint32_t n = 0;
+  cdr >> n;
+  *text = fmt("markers count=%u", n);
+  for (uint32_t k = 0; k < n; ++k) {
+    int32_t sec = 0, id = 0, type = 0, action = 0, life_sec = 0;
+    uint32_t nanosec = 0, life_nanosec = 0;
+    std::string frame, ns, texture_resource, texture_frame, texture_format, label, mesh_resource,
+        mesh_filename;
+    read_header(cdr, &sec, &nanosec, &frame);
+    cdr >> ns >> id >> type >> action;
+    double pose[7], scale[3];
+    cdr.deserializeArray(pose, 7);
+    cdr.deserializeArray(scale, 3);
+    float color[4];
+    cdr.deserializeArray(color, 4);
+    cdr >> life_sec >> life_nanosec;
+    bool frame_locked = false, embedded = false;
+    cdr >> frame_locked;
+    uint32_t points = 0;
+    cdr >> points;
+    double first[3] = {};
+    for (uint32_t p = 0; p < points; ++p) {
+      double xyz[3];
+      cdr.deserializeArray(xyz, 3);
+      if (p == 0) std::memcpy(first, xyz, sizeof xyz);
+    }
+    uint32_t colors = 0;
+    cdr >> colors;
+    for (uint32_t c = 0; c < colors; ++c) {
+      float rgba[4];
+      cdr.deserializeArray(rgba, 4);
+    }
+    cdr >> texture_resource;
+    int32_t tsec = 0;
+    uint32_t tnanosec = 0;
+    read_header(cdr, &tsec, &tnanosec, &texture_frame);
+    cdr >> texture_format;
+    std::vector<uint8_t> bytes;
+    cdr >> bytes;
+    uint32_t uvs = 0;
+    cdr >> uvs;
+    for (uint32_t u = 0; u < uvs; ++u) {
+      float uv[2];
+      cdr.deserializeArray(uv, 2);
+    }
+    cdr >> label >> mesh_resource >> mesh_filename >> bytes >> embedded;
+    *text +=
+        fmt(" | frame=%s sec=%d ns=%s id=%d type=%d action=%d x=%.9g y=%.9g z=%.9g qw=%.9g "
+            "scale=%.9g,%.9g,%.9g rgba=%.3g,%.3g,%.3g,%.3g lifetime=%d frame_locked=%d points=%u "
+            "first=%.9g,%.9g,%.9g colors=%u texture=%s uv=%u text=%s mesh=%s embedded=%d",
+            frame.c_str(), sec, ns.c_str(), id, type, action, pose[0], pose[1], pose[2], pose[6],
+            scale[0], scale[1], scale[2], color[0], color[1], color[2], color[3], life_sec,
+            frame_locked ? 1 : 0, points, first[0], first[1], first[2], colors,
+            texture_resource.c_str(), uvs, label.c_str(), mesh_resource.c_str(), embedded ? 1 : 0);
+  }
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -128,7 +265,8 @@ int main(int argc, char** argv) {
   int count = 3;
   long timeout_ms = 20000;
   bool odom = false;
-  std::string enclave_dir;  // set: DDS Security with this SROS2 enclave's files
+  std::string kind = "pose";  // pose | odom | tf | markers
+  std::string enclave_dir;    // set: DDS Security with this SROS2 enclave's files
   for (int k = 1; k + 1 < argc; k += 2) {
     if (std::strcmp(argv[k], "--domain") == 0)
       domain_id = std::atoi(argv[k + 1]);
@@ -139,15 +277,16 @@ int main(int argc, char** argv) {
     else if (std::strcmp(argv[k], "--timeout-ms") == 0)
       timeout_ms = std::atol(argv[k + 1]);
     else if (std::strcmp(argv[k], "--type") == 0)
-      odom = std::strcmp(argv[k + 1], "odom") == 0;
+      kind = argv[k + 1];
     else if (std::strcmp(argv[k], "--enclave-dir") == 0)
       enclave_dir = argv[k + 1];
   }
   if (topic_name.empty()) {
-    std::fprintf(stderr,
-                 "usage: %s --topic rt/<robot>/pose [--type pose|odom] [--domain ID] [--count N] "
-                 "[--timeout-ms T] [--enclave-dir DIR]\n",
-                 argv[0]);
+    std::fprintf(
+        stderr,
+        "usage: %s --topic rt/<robot>/pose [--type pose|odom|tf|markers] [--domain ID] [--count N] "
+        "[--timeout-ms T] [--enclave-dir DIR]\n",
+        argv[0]);
     return 2;
   }
 
@@ -188,7 +327,14 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "fastdds listener: cannot create a participant on domain %d\n", domain_id);
     return 1;
   }
-  fdds::TypeSupport type(new PoseType(odom));
+  odom = kind == "odom";
+  const bool decoded = kind == "tf" || kind == "markers";
+  fdds::TypeSupport type(
+      decoded ? static_cast<fdds::TopicDataType*>(
+                    kind == "tf" ? new DecodedType("tf2_msgs::msg::dds_::TFMessage_", &decode_tf)
+                                 : new DecodedType("visualization_msgs::msg::dds_::MarkerArray_",
+                                                   &decode_markers))
+              : new PoseType(odom));
   type.register_type(participant);
   fdds::Topic* topic =
       participant->create_topic(topic_name, type.get_type_name(), fdds::TOPIC_QOS_DEFAULT);
@@ -197,6 +343,8 @@ int main(int argc, char** argv) {
   rqos.reliability().kind = fdds::RELIABLE_RELIABILITY_QOS;  // as ROS 2's default profile
   rqos.history().kind = fdds::KEEP_LAST_HISTORY_QOS;
   rqos.history().depth = 10;
+  // The ceiling is published once, transient local: a late reader asks for it.
+  if (kind == "markers") rqos.durability().kind = fdds::TRANSIENT_LOCAL_DURABILITY_QOS;
   fdds::DataReader* reader = topic != nullptr && subscriber != nullptr
                                  ? subscriber->create_datareader(topic, rqos)
                                  : nullptr;
@@ -209,7 +357,18 @@ int main(int argc, char** argv) {
 
   int received = 0;
   const auto deadline = std::chrono::steady_clock::now() + std::chrono::milliseconds(timeout_ms);
-  while (received < count && std::chrono::steady_clock::now() < deadline) {
+  while (decoded && received < count && std::chrono::steady_clock::now() < deadline) {
+    if (!reader->wait_for_unread_message(eprosima::fastrtps::Duration_t(0, 200'000'000))) continue;
+    std::string text;
+    fdds::SampleInfo info;
+    while (received < count && reader->take_next_sample(&text, &info) == ReturnCode_t::RETCODE_OK) {
+      if (!info.valid_data) continue;
+      ++received;
+      std::printf("%s\n", text.c_str());
+      std::fflush(stdout);
+    }
+  }
+  while (!decoded && received < count && std::chrono::steady_clock::now() < deadline) {
     if (!reader->wait_for_unread_message(eprosima::fastrtps::Duration_t(0, 200'000'000))) continue;
     PoseMsg msg;
     fdds::SampleInfo info;
