@@ -6,7 +6,6 @@
 #include <string>
 
 #include "core/clock.h"
-#include "ipc/dds/dds_fleet_subscriber.h"
 #include "ipc/shm/pose_record.h"
 
 namespace ceilpose::test {
