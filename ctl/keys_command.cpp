@@ -73,8 +73,9 @@ void add_keys_command(CLI::App& app) {
   CLI::App* add_cmd = keys->add_subcommand(
       "add",
       "Create enclave NAME: an ECDSA P-256 key, a certificate CN=NAME signed by the CA, and\n"
-      "signed permissions to publish rt/NAME/* and subscribe to rt/*/pose and\n"
-      "rt/*/ceilpose_status. NAME is a ROS name (the robot's --robot). An existing enclave\n"
+      "signed permissions to publish rt/NAME/* and rt/tf and subscribe to rt/*/pose,\n"
+      "rt/*/ceilpose_status and rt/*/ceilpose_state (the fleet). NAME is a ROS name (the\n"
+      "robot's --robot). An existing enclave\n"
       "is replaced only with --force (rotating the robot's key).");
   add_cmd->add_option("--keystore", add->dir, "keystore directory made by 'keys init'")->required();
   add_cmd->add_option("--robot", add->robot, "robot (enclave) name")->required();
