@@ -4,15 +4,21 @@
 // camera or publishes anything, naming the file, with exit 6.
 #include <gtest/gtest.h>
 #include <signal.h>
+#include <unistd.h>
 
 #include <ctime>
 #include <filesystem>
 #include <map>
+#include <optional>
+#include <set>
 #include <string>
 #include <vector>
 
+#include "core/clock.h"
 #include "core/exit_codes.h"
 #include "core/text_file.h"
+#include "ipc/shm/shm_fleet_reader.h"
+#include "ipc/shm/shm_fleet_writer.h"
 #include "ipc/shm/shm_pose_writer.h"
 #include "tests/daemon/daemon_process.h"
 #include "tests/ipc/dds/dds_test_env.h"
@@ -95,6 +101,65 @@ TEST_F(DaemonSecurity, ASecureDaemonIsSeenByASecureFleetAndNotByAPlainOne) {
   auto exit = daemon.wait(5000);
   ASSERT_TRUE(exit.has_value()) << daemon.err();
   EXPECT_EQ(exit->code, ceilpose::kExitOk) << daemon.err();
+}
+
+// SPEC §12 on a secure domain: a robot with the fleet's certificate appears
+// in another's fleet segment; a robot without one never does, and sees
+// nobody itself.
+TEST_F(DaemonSecurity, OnlyAuthenticatedRobotsAppearInTheFleet) {
+  TempDir tmp;
+  const std::string ks = tmp.sub("keystore");
+  for (const auto& step :
+       {std::vector<std::string>{"keys", "init", "--keystore", ks},
+        std::vector<std::string>{"keys", "add", "--keystore", ks, "--robot", "seca"},
+        std::vector<std::string>{"keys", "add", "--keystore", ks, "--robot", "secb"}}) {
+    auto made = ctl(step);
+    ASSERT_EQ(made.exit_code, 0) << made.err;
+  }
+  // 10 fps: three synthetic cameras render on two cores.
+  const std::string config = write_temp_file("fleet.yaml", "capture:\n  fps: 10\n");
+  const std::string shm_b = unique_shm_name(), shm_c = unique_shm_name();
+  auto daemon_args = [&](const std::string& robot, const std::string& shm, bool secure) {
+    std::vector<std::string> a{"--config", config,     "--source", "synthetic", "--shm",
+                               shm,        "--domain", domain_,    "--robot",   robot};
+    if (secure) a.insert(a.end(), {"--keystore", ks});
+    return a;
+  };
+  DaemonProcess a(daemon_args("seca", shm_, true), env_);
+  DaemonProcess b(daemon_args("secb", shm_b, true), env_);
+  DaemonProcess c(daemon_args("plainc", shm_c, false), env_);
+  std::optional<ShmFleetReader> fleet_a;
+  std::vector<shm::FleetRecord> robots(256);
+  auto names_in = [&](ShmFleetReader& r) {
+    std::set<std::string> names;
+    const uint32_t n = r.read(0, robots.data(), 256);
+    for (uint32_t i = 0; i < n; ++i) names.insert(robots[i].robot);
+    return names;
+  };
+  const int64_t deadline = monotonic_ns() + int64_t{kBoundMs} * 1'000'000;
+  while (monotonic_ns() < deadline) {
+    if (!fleet_a) {
+      auto r = ShmFleetReader::open(shm_);
+      if (r) fleet_a.emplace(std::move(r).value());
+    }
+    if (fleet_a && names_in(*fleet_a).contains("secb")) break;
+    usleep(50'000);
+  }
+  ASSERT_TRUE(fleet_a && names_in(*fleet_a).contains("secb")) << a.err() << b.err();
+  // The plain robot publishes all along; give discovery three more seconds.
+  for (int k = 0; k < 30; ++k) {
+    EXPECT_FALSE(names_in(*fleet_a).contains("plainc"));
+    usleep(100'000);
+  }
+  EXPECT_EQ(names_in(*fleet_a), std::set<std::string>{"secb"});
+  auto fleet_c = ShmFleetReader::open(shm_c);
+  ASSERT_TRUE(fleet_c.ok()) << fleet_c.error().message << c.err();
+  EXPECT_TRUE(names_in(*fleet_c).empty()) << "a robot without a certificate sees nobody";
+  for (DaemonProcess* d : {&a, &b, &c}) d->signal(SIGTERM);
+  for (DaemonProcess* d : {&a, &b, &c}) EXPECT_TRUE(d->wait(10'000).has_value());
+  for (const std::string& s : {shm_b, shm_c}) (void)ShmPoseWriter::remove(s);
+  for (const std::string& s : {shm_, shm_b, shm_c})
+    (void)ShmFleetWriter::remove(fleet_segment_name(s));
 }
 
 TEST_F(DaemonSecurity, ATamperedPermissionsFileStopsTheDaemonNamingIt) {
