@@ -270,6 +270,8 @@ void describe(V& v, ServiceConfig& c) {
     v.field("history_depth", o.history_depth, 1, 1000);
     v.texts("interfaces", o.domain.interfaces, &check_no_space);
     v.texts("peers", o.domain.peers, &check_no_space);
+    // RTPS port arithmetic: 2 ports per index within a domain's 250.
+    v.field("max_participants_per_host", o.domain.max_participants_per_host, 1u, 120u);
     v.field("status_period_ms", d.status_period_ms, 10, 60'000);
     v.section("tf", [&] {
       v.field("enabled", o.rviz.tf);

@@ -124,7 +124,9 @@ std::string cyclone_config_xml(const DdsDomainOptions& options) {
   if (!options.peers.empty()) {
     // Unicast discovery reaches a peer's participants through the ports of
     // their participant indices, so each participant needs one.
-    xml += "<Discovery><ParticipantIndex>auto</ParticipantIndex><Peers>";
+    xml += "<Discovery><ParticipantIndex>auto</ParticipantIndex><MaxAutoParticipantIndex>" +
+           std::to_string(options.max_participants_per_host - 1) +
+           "</MaxAutoParticipantIndex><Peers>";
     for (const auto& peer : options.peers) xml += "<Peer address=\"" + peer + "\"/>";
     xml += "</Peers></Discovery>";
   }

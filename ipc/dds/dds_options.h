@@ -35,6 +35,10 @@ struct DdsDomainOptions {
   uint32_t domain_id = 0;               // SPEC §7: --domain, default 0; Cyclone allows 0..230
   std::vector<std::string> interfaces;  // network interface names or addresses, e.g. "eth0", "lo"
   std::vector<std::string> peers;       // unicast discovery peers, e.g. "10.0.0.7", "127.0.0.1"
+  // With peers (unicast discovery) every participant on a host needs a
+  // participant index, and Cyclone's default allows 10 (index 0..9): the
+  // eleventh daemon or tool on a host fails. RTPS port arithmetic allows 120.
+  uint32_t max_participants_per_host = 64;
   // Unset keeps Cyclone's default.
   std::optional<bool> allow_multicast;
   // Set: the participant authenticates, is access-controlled and encrypts

@@ -46,7 +46,13 @@ Result<DdsParticipant> DdsParticipant::create(const DdsDomainOptions& options) {
                                             options.security->certificate + " on " + domain_name +
                                             " (run with CYCLONEDDS_URI tracing 'security' for why)"
                                       : "cannot create a participant on " + domain_name +
-                                            " (check CYCLONEDDS_URI and the network interfaces)",
+                                            " (check CYCLONEDDS_URI and the network interfaces; "
+                                            "with unicast discovery (peers) a host holds at most "
+                                            "Discovery/MaxAutoParticipantIndex + 1 participants, "
+                                            "Cyclone's default 10: raise "
+                                            "dds.max_participants_per_host, or "
+                                            "MaxAutoParticipantIndex in CYCLONEDDS_URI; "
+                                            "docs/fleet.md)",
                      rc);
   }
   return p;

@@ -4,8 +4,10 @@
 
 #include <atomic>
 #include <cstdlib>
+#include <memory>
 #include <string>
 #include <thread>
+#include <vector>
 
 #include "core/clock.h"
 #include "ipc/dds/dds_fleet_listener.h"
@@ -173,6 +175,25 @@ TEST_F(DdsCrossProcess, FleetListenerKeepsLatestPoseOfRobotInAnotherProcess) {
   // The stamp is the publisher's CLOCK_REALTIME at capture: recent.
   EXPECT_NEAR(static_cast<double>(robots[0].latest.capture_realtime_ns),
               static_cast<double>(realtime_ns()), 30e9);
+}
+
+// Issue 26: with unicast discovery (dds.peers) Cyclone's default lets 10
+// participants share a host and the eleventh fails. ceilpose's own domain
+// configuration allows dds.max_participants_per_host (64): twelve robots on
+// one host all start.
+TEST(DdsManyParticipants, TwelveRobotsWithUnicastPeersShareOneHost) {
+  const std::string domain = std::to_string(test::unique_domain_id());
+  std::vector<std::unique_ptr<ChildProcess>> robots;
+  for (int k = 0; k < 12; ++k) {
+    robots.push_back(std::make_unique<ChildProcess>(std::vector<std::string>{
+        CEILPOSE_DDS_FAKE_ROBOT, "--robot",
+        test::unique_robot_name("many") + "_" + std::to_string(k), "--domain", domain,
+        "--interface", "lo", "--peer", "127.0.0.1", "--rate", "5", "--duration", "20"}));
+  }
+  for (auto& robot : robots) {
+    EXPECT_NE(robot->read_until("ready", kReadyTimeoutMs).find("ready"), std::string::npos)
+        << robot->output();
+  }
 }
 
 }  // namespace

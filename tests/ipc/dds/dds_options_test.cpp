@@ -83,6 +83,8 @@ TEST(DdsOptions, ConfigXmlCarriesInterfacesPeersAndMulticast) {
   EXPECT_NE(xml.find("<NetworkInterface address=\"192.168.1.5\"/>"), std::string::npos) << xml;
   EXPECT_NE(xml.find("<Peer address=\"127.0.0.1\"/>"), std::string::npos) << xml;
   EXPECT_NE(xml.find("<ParticipantIndex>auto</ParticipantIndex>"), std::string::npos) << xml;
+  EXPECT_NE(xml.find("<MaxAutoParticipantIndex>63</MaxAutoParticipantIndex>"), std::string::npos)
+      << "64 participants a host by default, not Cyclone's 10: " << xml;
   EXPECT_NE(xml.find("<AllowMulticast>false</AllowMulticast>"), std::string::npos) << xml;
 }
 
