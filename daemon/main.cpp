@@ -12,6 +12,7 @@
 #include "daemon/daemon_options.h"
 #include "daemon/logging.h"
 #include "daemon/service.h"
+#include "daemon/signal_channel.h"
 
 namespace {
 
@@ -32,6 +33,10 @@ int main(int argc, char** argv) {
   // A reader that goes away (`ceilposed ... | head`) must give write errors,
   // which are handled, not a death that leaves the segment marked dead.
   std::signal(SIGPIPE, SIG_IGN);
+  // Before anything else: a SIGTERM during start-up (loading the
+  // configuration, the keystore, DDS discovery) waits for the service's
+  // signal channel, which stops cleanly (signal_channel.h).
+  hold_stop_signals();
   DaemonOptions options;
   int exit_code = kExitOk;
   if (!parse_command_line(argc, argv, &options, &exit_code)) return exit_code;

@@ -9,6 +9,24 @@
 #include <system_error>
 
 namespace ceilpose::daemon {
+namespace {
+
+volatile std::sig_atomic_t g_noted_signal = 0;
+
+void note_signal(int sig) { g_noted_signal = sig; }
+
+}  // namespace
+
+void hold_stop_signals() {
+  struct sigaction action {};
+  action.sa_handler = &note_signal;
+  sigfillset(&action.sa_mask);
+  for (int sig : {SIGTERM, SIGINT, SIGHUP}) sigaction(sig, &action, nullptr);
+  sigset_t set;
+  sigemptyset(&set);
+  for (int sig : {SIGTERM, SIGINT, SIGHUP}) sigaddset(&set, sig);
+  pthread_sigmask(SIG_BLOCK, &set, nullptr);
+}
 
 SignalChannel::SignalChannel() {
   sigset_t set;
@@ -28,6 +46,10 @@ SignalChannel::~SignalChannel() {
 }
 
 int SignalChannel::wait(int timeout_ms) {
+  if (const int noted = g_noted_signal; noted != 0) {
+    g_noted_signal = 0;
+    return noted;
+  }
   pollfd p{fd_, POLLIN, 0};
   const int r = poll(&p, 1, timeout_ms < 0 ? 0 : timeout_ms);
   if (r <= 0) return 0;  // timeout, or EINTR: the caller's loop comes back

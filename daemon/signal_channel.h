@@ -9,6 +9,15 @@
 
 namespace ceilpose::daemon {
 
+// First thing in main(): SIGTERM, SIGINT and SIGHUP blocked for this thread
+// (and every thread it starts), and a handler that only notes the signal for
+// threads that do not block them yet: libraries' own threads started before
+// main (lttng-ust's, through libcamera) unblock nothing of ours but can be
+// handed a process-directed signal in their first instants. A noted signal
+// is the first SignalChannel::wait() returns. So a SIGTERM during start-up
+// stops the daemon cleanly instead of ending it by signal (issue 28 #15).
+void hold_stop_signals();
+
 class SignalChannel {
  public:
   SignalChannel();  // throws std::system_error if the signalfd cannot be made

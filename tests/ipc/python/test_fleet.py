@@ -100,7 +100,10 @@ class FleetOfThree(unittest.TestCase):
         self.assertNotIn(self.names["a"], fleet, "a robot is not its own neighbour")
         for k in "bc":
             errors_mm = []
-            for _ in range(40):
+            skipped = 0
+            for _ in range(200):
+                if len(errors_mm) >= 20:
+                    break
                 # One instant both copies can reach within the filter's
                 # horizon, however late a loaded machine makes them: just
                 # after the newer of B's own latest frame and A's copy.
@@ -111,12 +114,14 @@ class FleetOfThree(unittest.TestCase):
                 try:
                     own = self.clients[k].predict(t)  # where B (C) says it is at t
                 except ceilpose.CeilposeError:
-                    continue  # its frames went further apart than the horizon
-                if not theirs.predicted:
+                    own = None  # its frames went further apart than the horizon
+                if own is None or not theirs.predicted:
+                    skipped += 1  # a loaded machine: A's copy a horizon behind
+                    time.sleep(0.05)
                     continue
                 errors_mm.append(1000 * math.hypot(theirs.x_m - own.x_m, theirs.y_m - own.y_m))
                 time.sleep(0.05)
-            self.assertGreaterEqual(len(errors_mm), 10, errors_mm)
+            self.assertGreaterEqual(len(errors_mm), 10, (errors_mm, skipped))
             print(f"\nfleet: A's view of {k} vs {k}'s own, predicted to one instant: median "
                   f"{statistics.median(errors_mm):.3f} mm, max {max(errors_mm):.3f} mm",
                   file=sys.stderr)
