@@ -36,8 +36,7 @@ inline const char* check_shm_name(const std::string& s) {
 // Empty: the host name, made a ROS name (daemon/service.cpp).
 inline const char* check_robot_name(const std::string& s) {
   if (s.empty() || is_valid_ros_name(s)) return nullptr;
-  return "a ROS 2 name token: a letter or '_', then letters, digits and single '_' (no '-' or "
-         "'.')";
+  return kRosNameRule;
 }
 
 // Looked up here, so that a group missing on this machine is a

@@ -11,7 +11,8 @@ bool is_alnum(char c) { return std::isalnum(static_cast<unsigned char>(c)) != 0;
 }  // namespace
 
 bool is_valid_ros_name(std::string_view name) {
-  if (name.empty() || !(is_alpha(name[0]) || name[0] == '_')) return false;
+  if (name.empty() || name.size() > kMaxRobotNameLength || !(is_alpha(name[0]) || name[0] == '_'))
+    return false;
   for (size_t k = 0; k < name.size(); ++k) {
     const char c = name[k];
     if (!(is_alnum(c) || c == '_')) return false;
@@ -30,6 +31,7 @@ std::string to_ros_name(std::string_view text) {
   if (!out.empty() && std::isdigit(static_cast<unsigned char>(out[0])) != 0) {
     out.insert(out.begin(), 'r');
   }
+  if (out.size() > kMaxRobotNameLength) out.resize(kMaxRobotNameLength);
   return out;
 }
 

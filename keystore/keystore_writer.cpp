@@ -83,10 +83,8 @@ Result<void> init_keystore(const std::string& dir, const Validity& validity) {
 
 Result<void> add_enclave(const std::string& dir, const EnclaveRequest& request) {
   if (!is_valid_ros_name(request.name)) {
-    return make_error("'" + request.name +
-                      "' is not a valid robot name for DDS and ROS 2 (a letter or '_', then "
-                      "letters, digits and single '_'; e.g. '" +
-                      to_ros_name(request.name) + "')");
+    return make_error("'" + request.name + "' is not a valid robot name for DDS and ROS 2 (" +
+                      kRosNameRule + "; e.g. '" + to_ros_name(request.name) + "')");
   }
   if (auto ok = check_validity(request.validity); !ok) return ok;
   const KeystoreLayout ks{dir};

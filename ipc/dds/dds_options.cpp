@@ -83,9 +83,7 @@ Result<void> validate(const DdsDomainOptions& options) {
 
 Result<void> validate(const DdsOptions& options) {
   if (!is_valid_ros_name(options.robot)) {
-    return make_error("robot name '" + options.robot +
-                      "' is not a legal ROS name (letters, digits and single '_', not starting "
-                      "with a digit); e.g. '" +
+    return make_error("robot name '" + options.robot + "' is not " + kRosNameRule + "; e.g. '" +
                       to_ros_name(options.robot) + "'");
   }
   for (const std::string* frame : {&options.rviz.tf_parent_frame, &options.rviz.tf_child_frame}) {

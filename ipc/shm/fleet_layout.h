@@ -15,6 +15,7 @@
 #include <cstdint>
 
 #include "ceilpose/pose_client.h"
+#include "core/ros_name.h"
 #include "ipc/shm/shm_layout.h"
 
 namespace ceilpose::shm {
@@ -24,6 +25,7 @@ inline constexpr uint32_t kFleetAbiVersion = CEILPOSE_FLEET_ABI_VERSION;
 inline constexpr const char* kFleetSuffix = CEILPOSE_FLEET_SUFFIX;
 
 using FleetRecord = ::ceilpose_fleet_robot;
+static_assert(kMaxRobotNameLength < CEILPOSE_ROBOT_NAME_SIZE, "every robot name fits a slot");
 
 struct alignas(64) FleetHeader {
   // Identity: written once before `magic` (release).

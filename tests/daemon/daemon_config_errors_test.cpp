@@ -66,6 +66,11 @@ INSTANTIATE_TEST_SUITE_P(
                   "ceiling.rect_width_m: expected a marker"},
         BadConfig{"RobotNameNotARosName", "dds:\n  robot_name: my-robot\n",
                   "dds.robot_name: expected a ROS 2 name token"},
+        // Issue 28 #18: one length rule for robot names everywhere.
+        BadConfig{"RobotNameLongerThan63Characters",
+                  "dds:\n  robot_name: "
+                  "rrrrrrrrrrrrrrrrrrrrrrrrrrrrrrrrrrrrrrrrrrrrrrrrrrrrrrrrrrrrrrrr\n",
+                  "dds.robot_name: expected a ROS 2 name token of at most 63 characters"},
         BadConfig{"GroupThatDoesNotExist", "ipc:\n  group: nosuchgroup\n",
                   "ipc.group: expected an existing group"},
         BadConfig{"ShmNameIsADirectory", "ipc:\n  shm_name: /..\n",

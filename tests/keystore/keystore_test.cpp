@@ -152,6 +152,21 @@ TEST_F(KeystoreTest, AddRefusesANameThatIsNotARosNameAndAKeystoreWithoutCa) {
   EXPECT_NE(no_ca.error().message.find("keys init --keystore"), std::string::npos);
 }
 
+// Issue 28 #18: one length rule for robot names (63 characters: a
+// certificate's CN holds 64, the fleet segment's name field 63 and a NUL);
+// a name one longer is refused before anything is written, so a retry with
+// a good name is not told the enclave exists.
+TEST_F(KeystoreTest, ARobotNameOverTheLengthLimitIsRefusedLeavingNothingBehind) {
+  const std::string longest(63, 'a'), too_long(64, 'a');
+  auto refused = add_enclave(dir(), {.name = too_long, .validity = {now_, 10}});
+  ASSERT_FALSE(refused);
+  EXPECT_NE(refused.error().message.find("at most 63 characters"), std::string::npos)
+      << refused.error().message;
+  EXPECT_FALSE(std::filesystem::exists(layout().enclave_dir(too_long)));
+  auto made = add_enclave(dir(), {.name = longest, .validity = {now_, 10}});
+  EXPECT_TRUE(made) << made.error().message;
+}
+
 TEST_F(KeystoreTest, AnExistingEnclaveIsReplacedOnlyWhenAsked) {
   const std::string cert = slurp(r1().certificate);
   auto again = add_enclave(dir(), {.name = "r1", .validity = {now_, 10}});

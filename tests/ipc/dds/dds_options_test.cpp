@@ -18,6 +18,8 @@ TEST(DdsOptions, RejectsIllegalRosNames) {
   EXPECT_FALSE(is_valid_ros_name("robot.local"));
   EXPECT_FALSE(is_valid_ros_name("a__b"));
   EXPECT_FALSE(is_valid_ros_name("a/b"));
+  EXPECT_TRUE(is_valid_ros_name(std::string(63, 'r')));
+  EXPECT_FALSE(is_valid_ros_name(std::string(64, 'r'))) << "one length rule: 63 characters";
 }
 
 TEST(DdsOptions, ToRosNameTurnsHostNamesIntoLegalNames) {
@@ -25,6 +27,7 @@ TEST(DdsOptions, ToRosNameTurnsHostNamesIntoLegalNames) {
   EXPECT_EQ(to_ros_name("7up"), "r7up");
   EXPECT_EQ(to_ros_name("a--b"), "a_b");
   EXPECT_TRUE(is_valid_ros_name(to_ros_name("robot-7.lab")));
+  EXPECT_EQ(to_ros_name(std::string(80, 'h')), std::string(63, 'h')) << "a long host name";
 }
 
 TEST(DdsOptions, TopicNamesFollowRos2Mangling) {
