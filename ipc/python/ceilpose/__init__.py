@@ -19,6 +19,7 @@ docs/fleet.md the fleet segment behind Client.fleet().
 
 import ctypes
 import ctypes.util
+import math
 import os
 import time
 
@@ -122,12 +123,21 @@ if ctypes.sizeof(_FleetRecord) != 968 or _FleetRecord.latency_ns.offset != 944 o
     raise ImportError("ceilpose: ctypes layout of the fleet records does not match fleet ABI 1")
 
 
-def _instant(t_mono_ns, what):
-    """t_mono_ns as an int64, refusing what the C call cannot take."""
-    t = int(t_mono_ns)
-    if not _INT64_MIN <= t <= _INT64_MAX:
-        raise CeilposeError(-1, f"{what}: {t} ns is outside the 64-bit range of CLOCK_MONOTONIC")
-    return t
+def _whole(value, name, low, high, unit):
+    """`value` as an int within [low, high], else ValueError naming `name`:
+    ctypes would wrap it silently (2**64 + t becomes t)."""
+    if isinstance(value, bool) or not isinstance(value, (int, float)):
+        raise ValueError(f"{name} must be a number of {unit}, not {value!r}")
+    if isinstance(value, float) and not math.isfinite(value):
+        raise ValueError(f"{name} must be finite, not {value}")
+    if not low <= value <= high:
+        raise ValueError(f"{name} = {value} {unit} is outside {low}..{high}")
+    return int(value)
+
+
+def _instant(t_mono_ns, name):
+    """A CLOCK_MONOTONIC instant the C calls take (int64 ns)."""
+    return _whole(t_mono_ns, name, _INT64_MIN, _INT64_MAX, "ns")
 
 
 class CeilposeError(Exception):
@@ -276,6 +286,9 @@ class Client:
     def __init__(self, shm=DEFAULT_SHM):
         self._handle = ctypes.c_void_p()
         self._fleet = ctypes.c_void_p()  # opened by the first fleet()
+        if not isinstance(shm, str) or "\x00" in shm:
+            # A NUL would cut the name C sees ('/p2s\x00x' would open '/p2s').
+            raise ValueError(f"shm must be a segment name without NUL characters, not {shm!r}")
         self._fleet_records = None
         self._record = _PoseRecord()
         self._last_seq = 0
@@ -317,8 +330,14 @@ class Client:
         """Blocks until a pose newer than after_seq (default: the last one this
         client returned) exists, at most timeout_s seconds (None: forever)."""
         self._check_open()
-        after = self._last_seq if after_seq is None else after_seq
-        timeout_ms = -1 if timeout_s is None else max(0, min(int(timeout_s * 1000), 2**31 - 1))
+        after = self._last_seq if after_seq is None else _whole(after_seq, "after_seq", 0,
+                                                                 2**64 - 1, "poses")
+        if timeout_s is None:
+            timeout_ms = -1
+        else:
+            # Up to 24 days (the C call's int32 milliseconds); None waits forever.
+            _whole(timeout_s, "timeout_s", 0, (2**31 - 1) / 1000, "s (None: forever)")
+            timeout_ms = min(int(float(timeout_s) * 1000), 2**31 - 1)
         rc = _lib.ceilpose_client_wait_next(self._handle, after, timeout_ms,
                                             ctypes.byref(self._record))
         if rc != 0:
@@ -330,7 +349,7 @@ class Client:
         filter: "where am I now". HORIZON beyond the daemon's
         filter.predict_horizon_ms, NO_MOTION without a filtered pose."""
         self._check_open()
-        t = time.monotonic_ns() if t_mono_ns is None else _instant(t_mono_ns, f"predict on {self.shm}")
+        t = time.monotonic_ns() if t_mono_ns is None else _instant(t_mono_ns, "t_mono_ns")
         rc = _lib.ceilpose_client_predict(self._handle, t, ctypes.byref(self._record))
         if rc != 0:
             _raise(rc, f"cannot predict the pose on {self.shm} to {t} ns")
@@ -343,6 +362,7 @@ class Client:
         whether it could be), else as received. NOT_FOUND when the daemon
         keeps no fleet (fleet.enabled false, or DDS off)."""
         self._check_open()
+        t = 0 if t_mono_ns is None else _instant(t_mono_ns, "t_mono_ns")
         if not self._fleet:
             rc = _lib.ceilpose_client_fleet_open(self.shm.encode(), ctypes.byref(self._fleet))
             if rc != 0:
@@ -350,7 +370,6 @@ class Client:
             info = _FleetInfo()
             _lib.ceilpose_client_fleet_info(self._fleet, ctypes.byref(info))
             self._fleet_records = (_FleetRecord * info.capacity)()
-        t = 0 if t_mono_ns is None else _instant(t_mono_ns, f"fleet of {self.shm}")
         count = ctypes.c_uint32()
         rc = _lib.ceilpose_client_fleet_read(self._fleet, t, self._fleet_records,
                                              len(self._fleet_records), ctypes.byref(count))

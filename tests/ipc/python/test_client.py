@@ -102,7 +102,28 @@ class ClientAgainstDaemon(unittest.TestCase):
         self.assertEqual(e.exception.name, "TIMEOUT")
 
 
+    def test_arguments_ctypes_would_wrap_are_refused_by_name(self):
+        # Issue 28 #19: 2**64 + t became t, 2**70 became 0, inf overflowed.
+        now = time.monotonic_ns()
+        for call, name in ((lambda: self.client.predict(2**64 + now), "t_mono_ns"),
+                           (lambda: self.client.predict(float("nan")), "t_mono_ns"),
+                           (lambda: self.client.fleet(2**64), "t_mono_ns"),
+                           (lambda: self.client.wait_next(after_seq=2**70), "after_seq"),
+                           (lambda: self.client.wait_next(after_seq=-1), "after_seq"),
+                           (lambda: self.client.wait_next(timeout_s=float("inf")), "timeout_s"),
+                           (lambda: self.client.wait_next(timeout_s=-1), "timeout_s"),
+                           (lambda: self.client.wait_next(timeout_s="1"), "timeout_s")):
+            with self.assertRaises(ValueError) as e:
+                call()
+            self.assertIn(name, str(e.exception))
+
+
 class ClientWithoutDaemon(unittest.TestCase):
+    def test_a_name_with_a_nul_is_refused_not_cut(self):
+        with self.assertRaises(ValueError) as e:
+            ceilpose.Client("/p2s\x00x")
+        self.assertIn("NUL", str(e.exception))
+
     def test_a_missing_segment_says_so(self):
         name = f"/ceilpose-pytest-missing-{os.getpid()}"
         with self.assertRaises(ceilpose.CeilposeError) as e:
