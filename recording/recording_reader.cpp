@@ -17,6 +17,7 @@
 #include <sstream>
 #include <string_view>
 
+#include "core/message_text.h"
 #include "core/text_file.h"
 #include "core/yaml_duplicate_keys.h"
 #include "recording/frame_file.h"
@@ -41,22 +42,8 @@ void RecordingReader::DecodeBuffersDeleter::operator()(DecodeBuffers* b) const {
 
 namespace {
 
-// 'text' for an error message, with bytes that would not show (controls,
-// non-ASCII) as \xNN so the reader sees what is really in the file.
-std::string quoted(std::string_view text) {
-  std::string out = "'";
-  for (const char c : text) {
-    const auto u = static_cast<unsigned char>(c);
-    if (u < 0x20 || u >= 0x7f) {
-      char esc[8];
-      std::snprintf(esc, sizeof esc, "\\x%02X", static_cast<unsigned>(u));
-      out += esc;
-    } else {
-      out += c;
-    }
-  }
-  return out + "'";
-}
+// 'text' for an error message: escaped, and cut when long (core/message_text.h).
+std::string quoted(std::string_view text) { return shown_value(text); }
 
 // ---- recording.yaml -------------------------------------------------------
 
@@ -378,11 +365,11 @@ Result<RecordingRow> parse_row(const std::vector<std::string>& fields, const Col
 Result<void> check_frame_file(const std::string& frame_path, int line_no) {
   struct stat fst {};
   if (::stat(frame_path.c_str(), &fst) != 0) {
-    return make_error(frame_path + " (frames.csv:" + std::to_string(line_no) +
+    return make_error(shown_value(frame_path) + " (frames.csv:" + std::to_string(line_no) +
                       "): frame file missing (" + std::strerror(errno) + ")");
   }
   if (!S_ISREG(fst.st_mode)) {
-    return make_error(frame_path + " (frames.csv:" + std::to_string(line_no) +
+    return make_error(shown_value(frame_path) + " (frames.csv:" + std::to_string(line_no) +
                       "): not a regular file");
   }
   return {};

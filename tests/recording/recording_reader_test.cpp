@@ -208,6 +208,18 @@ TEST_F(RecordingReaderTest, FrameIndexOutOfRangeIsAnError) {
   expect_mentions(ok.error().message, {"out of range"});
 }
 
+// Issue 28 #21: a 1 MB file name in frames.csv is named in one line of
+// message, its start and end with how much was left out, not echoed whole.
+TEST_F(RecordingReaderTest, AHugeFileNameIsCutInTheMessage) {
+  write_valid(2);
+  replace_line(dir_ + "/frames.csv", 2,
+               "0,1000000000," + std::string(1'000'000, 'x') + ".png,0.5,0.5,0");
+  const std::string error = first_reader_error(dir_);
+  ASSERT_FALSE(error.empty());
+  EXPECT_LT(error.size(), 600u) << error.substr(0, 600);
+  expect_mentions(error, {"frames.csv:2", "more bytes)", "x.png'"});
+}
+
 // ---- every malformed recording: an error naming the file and the line ----
 
 class MalformedRecording : public ::testing::TestWithParam<MalformedCase> {};

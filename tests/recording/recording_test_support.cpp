@@ -306,7 +306,7 @@ std::vector<MalformedCase> make_cases() {
   c.push_back({"MissingFrameFile",
                png,
                [=](const std::string& d) { fs::remove(d + "/frames/000002.png"); },
-               {"frames/000002.png (frames.csv:4)", "missing"}});
+               {"frames/000002.png' (frames.csv:4)", "missing"}});
   c.push_back({"TruncatedPng",
                png,
                [=](const std::string& d) { truncate_file(d + "/frames/000003.png", 0.5); },
