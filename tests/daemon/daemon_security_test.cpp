@@ -86,7 +86,9 @@ TEST_F(DaemonSecurity, ASecureDaemonIsSeenByASecureFleetAndNotByAPlainOne) {
   ASSERT_NE(daemon.err().find("DDS Security: enclave secbot of keystore " + ks), std::string::npos)
       << daemon.err();
 
-  auto secure = ctl({"fleet", "--json", "--duration", "3", "--domain", domain_, "--keystore", ks,
+  // 6 s: the secure handshakes of every endpoint the daemon has (pose, odom,
+  // status, state, TF, ceiling, the fleet's readers) take seconds under ASan.
+  auto secure = ctl({"fleet", "--json", "--duration", "6", "--domain", domain_, "--keystore", ks,
                      "--enclave", "monitor"});
   auto plain = ctl({"fleet", "--json", "--duration", "3", "--domain", domain_});
   ASSERT_EQ(secure.exit_code, 0) << secure.err;
