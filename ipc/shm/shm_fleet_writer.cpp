@@ -23,15 +23,7 @@ constexpr mode_t kFleetMode = 0640;
 constexpr uint32_t kMaxCapacity = 65536;
 
 // The pid in an existing fleet segment's header, for the "live writer" message.
-int fleet_writer_pid(int fd) {
-  struct stat st {};
-  if (::fstat(fd, &st) != 0 || static_cast<size_t>(st.st_size) < sizeof(FleetHeader)) return 0;
-  int error = 0;
-  shm::Mapping m = shm::map_shared(fd, sizeof(FleetHeader), false, shm::OnShrink::kDetach, &error);
-  if (m.get() == nullptr) return 0;
-  const auto* h = static_cast<const FleetHeader*>(m.get());
-  return h->magic.load(std::memory_order_acquire) == shm::kFleetMagic ? h->writer_pid : 0;
-}
+int fleet_writer_pid(int fd) { return shm::header_writer_pid<FleetHeader>(fd, shm::kFleetMagic); }
 
 constexpr shm::SegmentOwnerHooks kFleetSegmentHooks{&fleet_writer_pid, nullptr};
 

@@ -36,17 +36,9 @@ constexpr mode_t kSegmentMode = 0640;
 // Readers must write the waiter count, so the companion is group-writable.
 constexpr mode_t kWakeMode = 0660;
 
-// Reads the writer pid of an existing segment for the "live writer" message;
-// 0 when the segment is not (yet) a valid one.
+// The writer pid of an existing pose segment, for the "live writer" message.
 int existing_writer_pid(int fd) {
-  struct stat st {};
-  if (::fstat(fd, &st) != 0 || static_cast<size_t>(st.st_size) != sizeof(Segment)) return 0;
-  int error = 0;
-  Mapping m = shm::map_shared(fd, sizeof(Segment), false, shm::OnShrink::kDetach, &error);
-  if (m.get() == nullptr) return 0;
-  const auto* seg = static_cast<const Segment*>(m.get());
-  if (seg->header.magic.load(std::memory_order_acquire) != shm::kMagic) return 0;
-  return seg->header.writer_pid;
+  return shm::header_writer_pid<shm::SegmentHeader>(fd, shm::kMagic);
 }
 
 // Blocked readers of a segment about to be replaced re-check their writer.

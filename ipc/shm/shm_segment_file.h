@@ -7,6 +7,7 @@
 #include <sys/stat.h>
 #include <sys/types.h>
 
+#include <atomic>
 #include <cstddef>
 #include <cstdint>
 #include <string>
@@ -24,6 +25,20 @@ struct SegmentOwnerHooks {
   // Called before a dead writer's segment is unlinked (e.g. to wake readers).
   void (*before_replace)(int fd) = nullptr;
 };
+
+// The writer pid in the header (type Header: `magic`, `writer_pid`) of an
+// existing segment, for the "live writer" message; 0 when the file is not a
+// complete segment of that kind.
+template <typename Header>
+int header_writer_pid(int fd, uint64_t magic) {
+  struct stat st {};
+  if (::fstat(fd, &st) != 0 || static_cast<size_t>(st.st_size) < sizeof(Header)) return 0;
+  int error = 0;
+  Mapping m = map_shared(fd, sizeof(Header), false, OnShrink::kDetach, &error);
+  if (m.get() == nullptr) return 0;
+  const auto* header = static_cast<const Header*>(m.get());
+  return header->magic.load(std::memory_order_acquire) == magic ? header->writer_pid : 0;
+}
 
 // Unique per writer start.
 uint64_t new_generation();
