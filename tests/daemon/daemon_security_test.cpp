@@ -86,13 +86,19 @@ TEST_F(DaemonSecurity, ASecureDaemonIsSeenByASecureFleetAndNotByAPlainOne) {
   ASSERT_NE(daemon.err().find("DDS Security: enclave secbot of keystore " + ks), std::string::npos)
       << daemon.err();
 
-  // 6 s: the secure handshakes of every endpoint the daemon has (pose, odom,
-  // status, state, TF, ceiling, the fleet's readers) take seconds under ASan.
-  auto secure = ctl({"fleet", "--json", "--duration", "6", "--domain", domain_, "--keystore", ks,
-                     "--enclave", "monitor"});
+  // Up to three listens of 6 s: the secure handshakes of every endpoint the
+  // daemon has (pose, odom, status, state, TF, ceiling, the fleet's readers)
+  // take seconds under ASan on a loaded machine.
+  RunOutput secure;
+  std::string obj;
+  for (int attempt = 0; attempt < 3; ++attempt) {
+    secure = ctl({"fleet", "--json", "--duration", "6", "--domain", domain_, "--keystore", ks,
+                  "--enclave", "monitor"});
+    ASSERT_EQ(secure.exit_code, 0) << secure.err;
+    obj = robot_object(secure.out, "secbot");
+    if (!obj.empty() && number_field(obj, "samples") > 5.0) break;
+  }
   auto plain = ctl({"fleet", "--json", "--duration", "3", "--domain", domain_});
-  ASSERT_EQ(secure.exit_code, 0) << secure.err;
-  const std::string obj = robot_object(secure.out, "secbot");
   ASSERT_FALSE(obj.empty()) << secure.out << daemon.err();
   EXPECT_GT(number_field(obj, "samples"), 5.0) << obj;
   EXPECT_TRUE(std::isfinite(number_field(obj, "x_m"))) << obj;
