@@ -15,6 +15,7 @@
 #include "calibration/board_spec.h"
 #include "calibration/camera_info_file.h"
 #include "calibration/mount_estimate.h"
+#include "core/output_guard.h"
 #include "core/text_file.h"
 #include "ctl/calibration_options.h"
 #include "ctl/command_registry.h"
@@ -52,13 +53,16 @@ Result<Views> find_boards(const RecordingReader& reader, const BoardSpec& board)
   for (size_t i = 0; i < reader.rows().size(); ++i) {
     if (auto loaded = reader.load_frame(i, &image); !loaded) return loaded.error();
     const ImageView v = image.view();
-    cv::Mat rgb(v.height, v.width, CV_8UC3, const_cast<uint8_t*>(v.data), v.stride_bytes);
+    // SPEC §4 allows greyscale frames: only colour ones are converted.
     cv::Mat gray;
-    if (v.format == PixelFormat::kGray8)
+    if (v.format == PixelFormat::kGray8) {
       gray = cv::Mat(v.height, v.width, CV_8UC1, const_cast<uint8_t*>(v.data), v.stride_bytes);
-    else
-      cv::cvtColor(rgb, gray,
+    } else {
+      const cv::Mat colour(v.height, v.width, CV_8UC3, const_cast<uint8_t*>(v.data),
+                           v.stride_bytes);
+      cv::cvtColor(colour, gray,
                    v.format == PixelFormat::kBgr24 ? cv::COLOR_BGR2GRAY : cv::COLOR_RGB2GRAY);
+    }
     std::vector<cv::Point2f> corners;
     const bool found = cv::findChessboardCorners(
         gray, pattern, corners,
@@ -79,10 +83,93 @@ Result<Views> find_boards(const RecordingReader& reader, const BoardSpec& board)
   return views;
 }
 
+// Views closer than this to a kept one (mean corner distance) add nothing:
+// twelve frames of a board that did not move are one view.
+constexpr double kDistinctViewPx = 1.0;
+// A calibration is refused when its focal lengths are known no better than
+// this (relative 1-sigma), or when the views left out of it are reprojected
+// worse than kMaxHeldOutPx and kMaxHeldOutRatio times the fit's RMS: it
+// fits the views it saw and not the camera.
+constexpr double kMaxFocalSigma = 0.01;
+constexpr double kMaxHeldOutPx = 1.0;
+constexpr double kMaxHeldOutRatio = 3.0;
+// A view is flagged when left out it is reprojected this many times worse
+// than the median view (and worse than 0.5 px).
+constexpr double kOutlierRatio = 4.0;
+// Leave-one-out beyond this many views leaves out folds of views.
+constexpr size_t kMaxFolds = 30;
+
+// Drops views that repeat an earlier one; returns how many were dropped.
+size_t keep_distinct_views(Views* views) {
+  Views kept;
+  kept.frames = views->frames;
+  for (size_t v = 0; v < views->corners.size(); ++v) {
+    bool repeat = false;
+    for (const auto& other : kept.corners) {
+      double sum = 0.0;
+      for (size_t c = 0; c < other.size(); ++c)
+        sum += std::hypot(other[c].x - views->corners[v][c].x, other[c].y - views->corners[v][c].y);
+      if (sum / static_cast<double>(other.size()) < kDistinctViewPx) repeat = true;
+    }
+    if (repeat) continue;
+    kept.corners.push_back(views->corners[v]);
+    kept.index.push_back(views->index[v]);
+  }
+  const size_t dropped = views->corners.size() - kept.corners.size();
+  *views = std::move(kept);
+  return dropped;
+}
+
+double view_rms_px(const std::vector<cv::Point3f>& model, const std::vector<cv::Point2f>& corners,
+                   const cv::Mat& k, const cv::Mat& dist) {
+  cv::Mat rvec, tvec;
+  cv::solvePnP(model, corners, k, dist, rvec, tvec);
+  std::vector<cv::Point2f> projected;
+  cv::projectPoints(model, rvec, tvec, k, dist, projected);
+  double sum = 0.0;
+  for (size_t c = 0; c < corners.size(); ++c) {
+    const double d = std::hypot(projected[c].x - corners[c].x, projected[c].y - corners[c].y);
+    sum += d * d;
+  }
+  return std::sqrt(sum / static_cast<double>(corners.size()));
+}
+
+// Each view's RMS reprojection error by a camera calibrated without it
+// (cross-validation: folds of views when there are more than kMaxFolds).
+std::vector<double> held_out_errors_px(const std::vector<cv::Point3f>& model, const Views& views,
+                                       const cv::Size& size, const cv::Mat& k0,
+                                       const cv::Mat& dist0) {
+  const size_t n = views.corners.size();
+  const size_t folds = std::min(n, kMaxFolds);
+  std::vector<double> errors(n, 0.0);
+  for (size_t fold = 0; fold < folds; ++fold) {
+    std::vector<std::vector<cv::Point3f>> object;
+    std::vector<std::vector<cv::Point2f>> corners;
+    for (size_t v = 0; v < n; ++v)
+      if (v % folds != fold) {
+        object.push_back(model);
+        corners.push_back(views.corners[v]);
+      }
+    cv::Mat k = k0.clone(), dist = dist0.clone();
+    std::vector<cv::Mat> rvecs, tvecs;
+    cv::calibrateCamera(object, corners, size, k, dist, rvecs, tvecs,
+                        cv::CALIB_USE_INTRINSIC_GUESS);
+    for (size_t v = fold; v < n; v += folds)
+      errors[v] = view_rms_px(model, views.corners[v], k, dist);
+  }
+  return errors;
+}
+
 void run_calibrate_camera(const CameraArgs& args) {
   Result<BoardSpec> board = parse_board_spec(args.board);
   if (!board) {
     std::fprintf(stderr, "ceilposectl calibrate camera: %s\n", board.error().message.c_str());
+    return set_exit_code(kExitUsage);
+  }
+  if (auto clash =
+          check_outputs_are_not_inputs({{"--out", args.out_file}}, {}, {{"--replay", args.dir}});
+      !clash) {
+    std::fprintf(stderr, "ceilposectl calibrate camera: %s\n", clash.error().message.c_str());
     return set_exit_code(kExitUsage);
   }
   auto reader = RecordingReader::open(args.dir);
@@ -95,15 +182,25 @@ void run_calibrate_camera(const CameraArgs& args) {
     std::fprintf(stderr, "ceilposectl calibrate camera: %s\n", views.error().message.c_str());
     return set_exit_code(kExitBadInput);
   }
+  const size_t found = views->corners.size();
+  const size_t repeats = keep_distinct_views(&*views);
   const size_t n = views->corners.size();
   if (n < static_cast<size_t>(kMinViews)) {
     std::fprintf(stderr,
-                 "ceilposectl calibrate camera: the %dx%d board was found in %zu of %zu frames; "
-                 "at least %d views are needed (check --board's inner-corner count, lighting and "
-                 "focus)\n",
-                 board->cols, board->rows, n, views->frames, kMinViews);
+                 "ceilposectl calibrate camera: the %dx%d board was found in %zu of %zu frames",
+                 board->cols, board->rows, found, views->frames);
+    if (repeats > 0)
+      std::fprintf(stderr, ", %zu of them repeating another view (within %.1f px): %zu distinct",
+                   repeats, kDistinctViewPx, n);
+    std::fprintf(stderr,
+                 "; at least %d views are needed (check --board's inner-corner count, lighting and "
+                 "focus; move and tilt the board between views)\n",
+                 kMinViews);
     return set_exit_code(kExitFailure);
   }
+  if (repeats > 0)
+    std::fprintf(stderr, "calibrate camera: %zu views repeat another (within %.1f px): not used\n",
+                 repeats, kDistinctViewPx);
   std::vector<cv::Point3f> model;
   for (int r = 0; r < board->rows; ++r)
     for (int c = 0; c < board->cols; ++c)
@@ -118,16 +215,36 @@ void run_calibrate_camera(const CameraArgs& args) {
   const double rms = cv::calibrateCamera(object, views->corners, size, k, dist, rvecs, tvecs,
                                          std_intrinsics, std_extrinsics, per_view);
   std::fprintf(stderr, "calibrate camera: %zu views, RMS reprojection error %.3f px\n", n, rms);
+  const std::vector<double> held_out = held_out_errors_px(model, *views, size, k, dist);
+  std::vector<double> sorted = held_out;
+  std::sort(sorted.begin(), sorted.end());
+  const double median_held_out = sorted[n / 2];
+  double held_out_sq = 0.0;
+  for (double e : held_out) held_out_sq += e * e;
+  const double held_out_rms = std::sqrt(held_out_sq / static_cast<double>(n));
   double max_tilt_deg = 0.0;
+  size_t flagged = 0;
   for (size_t v = 0; v < n; ++v) {
     cv::Mat r;
     cv::Rodrigues(rvecs[v], r);
     const double tilt_deg = kDeg * std::acos(std::min(1.0, std::abs(r.at<double>(2, 2))));
     max_tilt_deg = std::max(max_tilt_deg, tilt_deg);
-    std::fprintf(stderr, "  view %3zu (frame %lld): %.3f px, board tilted %.1f deg\n", v,
-                 static_cast<long long>(views->index[v]), per_view.at<double>(static_cast<int>(v)),
-                 tilt_deg);
+    const bool outlier = held_out[v] > std::max(0.5, kOutlierRatio * median_held_out);
+    flagged += outlier ? 1 : 0;
+    std::fprintf(stderr,
+                 "  view %3zu (frame %lld): %.3f px in the fit, %.3f px left out, board tilted "
+                 "%.1f deg%s\n",
+                 v, static_cast<long long>(views->index[v]),
+                 per_view.at<double>(static_cast<int>(v)), held_out[v], tilt_deg,
+                 outlier ? "  <- does not fit the others (blurred, moved, or a wrong corner "
+                           "order?): consider removing it"
+                         : "");
   }
+  std::fprintf(stderr,
+               "calibrate camera: left out of the fit, the views reproject at %.3f px RMS "
+               "(median %.3f px)%s\n",
+               held_out_rms, median_held_out,
+               flagged > 0 ? "; some views do not fit (marked above)" : "");
   // Coverage: which cells of a 4 x 4 grid over the image have corners.
   bool cell[4][4] = {};
   for (const auto& view : views->corners)
@@ -153,13 +270,34 @@ void run_calibrate_camera(const CameraArgs& args) {
   out.cx = k.at<double>(0, 2);
   out.cy = k.at<double>(1, 2);
   for (int c = 0; c < 5; ++c) out.distortion[static_cast<size_t>(c)] = dist.at<double>(c);
+  const double sigma_fx = std_intrinsics.at<double>(0), sigma_fy = std_intrinsics.at<double>(1);
   std::fprintf(stderr,
                "calibrate camera: fx %.2f +- %.2f, fy %.2f +- %.2f, cx %.2f +- %.2f, cy %.2f +- "
                "%.2f px; k1 %.5f k2 %.5f p1 %.6f p2 %.6f k3 %.5f\n",
-               out.fx, std_intrinsics.at<double>(0), out.fy, std_intrinsics.at<double>(1), out.cx,
-               std_intrinsics.at<double>(2), out.cy, std_intrinsics.at<double>(3),
-               out.distortion[0], out.distortion[1], out.distortion[2], out.distortion[3],
-               out.distortion[4]);
+               out.fx, sigma_fx, out.fy, sigma_fy, out.cx, std_intrinsics.at<double>(2), out.cy,
+               std_intrinsics.at<double>(3), out.distortion[0], out.distortion[1],
+               out.distortion[2], out.distortion[3], out.distortion[4]);
+  std::string refusal;
+  char why[256];
+  if (!(sigma_fx <= kMaxFocalSigma * out.fx && sigma_fy <= kMaxFocalSigma * out.fy)) {
+    std::snprintf(why, sizeof why,
+                  "the focal lengths are undetermined (1-sigma %.1f and %.1f px, over %.0f %%): "
+                  "the views are too alike; tilt the board 20-45 deg in several directions",
+                  sigma_fx, sigma_fy, 100.0 * kMaxFocalSigma);
+    refusal = why;
+  } else if (!std::isfinite(held_out_rms) ||
+             (held_out_rms > kMaxHeldOutPx && held_out_rms > kMaxHeldOutRatio * rms)) {
+    std::snprintf(why, sizeof why,
+                  "the calibration does not generalise: views left out of the fit reproject at "
+                  "%.3f px RMS against %.3f px in it (limits %.1f px and %.0fx)",
+                  held_out_rms, rms, kMaxHeldOutPx, kMaxHeldOutRatio);
+    refusal = why;
+  }
+  if (!refusal.empty()) {
+    std::fprintf(stderr, "ceilposectl calibrate camera: %s; %s was not written\n", refusal.c_str(),
+                 args.out_file.c_str());
+    return set_exit_code(kExitFailure);
+  }
   if (auto wrote = write_camera_info_file(args.out_file, out); !wrote) {
     std::fprintf(stderr, "ceilposectl calibrate camera: %s\n", wrote.error().message.c_str());
     return set_exit_code(kExitFailure);
@@ -188,7 +326,22 @@ class CameraTrack final : public PoseSink {
   std::vector<CameraSample> samples;
 };
 
+// The replay's files (--replay, --config, --camera, --map) as a calibration's
+// inputs, for check_outputs_are_not_inputs.
+std::vector<NamedPath> replay_input_files(const ReplayArgs& replay) {
+  return {{"--config", replay.config_file},
+          {"--camera", replay.calibration.camera_file},
+          {"--map", replay.calibration.map_file}};
+}
+
 void run_calibrate_mount(MountArgs& args) {
+  if (auto clash =
+          check_outputs_are_not_inputs({{"--out", args.out_file}}, replay_input_files(args.replay),
+                                       {{"--replay", args.replay.dir}});
+      !clash) {
+    std::fprintf(stderr, "ceilposectl calibrate mount: %s\n", clash.error().message.c_str());
+    return set_exit_code(kExitUsage);
+  }
   ReplaySetup setup;
   args.replay.mode_text = "lsq";
   int rc = prepare_replay(args.replay, "calibrate mount", &setup);

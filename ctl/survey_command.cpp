@@ -14,6 +14,7 @@
 
 #include "calibration/camera_info_file.h"
 #include "calibration/map_file.h"
+#include "core/output_guard.h"
 #include "ctl/calibration_options.h"
 #include "ctl/command_registry.h"
 #include "ctl/replay_run.h"
@@ -144,6 +145,15 @@ int collect(const SurveyArgs& args, const CameraIntrinsics* camera, PipelineConf
 }
 
 void run_survey(const SurveyArgs& args) {
+  std::vector<NamedPath> dirs;
+  for (const std::string& dir : args.dirs) dirs.push_back({"--replay", dir});
+  if (auto clash = check_outputs_are_not_inputs(
+          {{"--out", args.out_file}, {"--camera-out", args.camera_out_file}},
+          {{"--config", args.config_file}, {"--camera", args.camera_file}}, dirs);
+      !clash) {
+    std::fprintf(stderr, "ceilposectl survey: %s\n", clash.error().message.c_str());
+    return set_exit_code(kExitUsage);
+  }
   std::vector<SurveyFrame> frames;
   PipelineConfig config;
   if (int rc = collect(args, nullptr, &config, &frames); rc != kExitOk) return set_exit_code(rc);

@@ -9,6 +9,10 @@
 #include <filesystem>
 #include <fstream>
 #include <numbers>
+#include <opencv2/calib3d.hpp>
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
+#include <vector>
 
 #include "calibration/camera_info_file.h"
 #include "config/service_config.h"
@@ -103,6 +107,131 @@ TEST_F(Calibrate, CameraWithTooFewViewsIsRefusedSayingSo) {
   auto usage = run_ceilposectl(
       {"calibrate", "camera", "--replay", path("few"), "--board", "chessboard:9x6"}, kSlowMs);
   EXPECT_EQ(usage.exit_code, 2) << usage.err;
+}
+
+// Debian's opencv-doc package: OpenCV's own real checkerboard photographs
+// (640x480 greyscale JPEG, 9x6 inner corners), installed by scripts/setup.
+const char* kOpenCvPhotos = "/usr/share/doc/opencv-doc/examples/data";
+const char* kPhotoNames[] = {"left01", "left02", "left03", "left04", "left05", "left06", "left07",
+                             "left08", "left09", "left11", "left12", "left13", "left14"};
+
+// A recording (SPEC §4) of the given frame files, copied in order.
+void write_photo_recording(const fs::path& dir, const std::vector<std::string>& files) {
+  fs::create_directories(dir / "frames");
+  std::ofstream csv(dir / "frames.csv");
+  csv << "index,timestamp_ns,file\n";
+  for (size_t i = 0; i < files.size(); ++i) {
+    const std::string name = "frames/" + std::to_string(100000 + i).substr(1) + ".jpg";
+    fs::copy_file(files[i], dir / name);
+    csv << i << "," << 1'000'000'000 + 100'000'000 * static_cast<long long>(i) << "," << name
+        << "\n";
+  }
+  std::ofstream(dir / "recording.yaml")
+      << "format: ceilpose-recording\nversion: 1\ncamera:\n  width: 640\n  height: 480\n"
+         "  fx: 530.0\n  fy: 530.0\n  cx: 319.5\n  cy: 239.5\n"
+         "  distortion: [0.0, 0.0, 0.0, 0.0, 0.0]\n";
+}
+
+double number_after(const std::string& text, const std::string& key) {
+  const size_t at = text.find(key);
+  return at == std::string::npos ? NAN : std::stod(text.substr(at + key.size()));
+}
+
+TEST_F(Calibrate, CameraFromRealGreyscalePhotographsGeneralisesAsWellAsOpenCv) {
+  std::vector<std::string> files;
+  for (const char* name : kPhotoNames)
+    files.push_back(std::string(kOpenCvPhotos) + "/" + name + ".jpg");
+  ASSERT_TRUE(fs::exists(files.front())) << files.front() << ": run scripts/setup (opencv-doc)";
+  write_photo_recording(dir_ / "photos", files);
+  auto r = run_ceilposectl({"calibrate", "camera", "--replay", path("photos"), "--board",
+                            "checkerboard:9x6:0.025", "--out", path("camera.yaml")},
+                           kSlowMs);
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const double ours = number_after(r.err, "the views reproject at ");
+  // OpenCV's calibrateCamera, left-one-out, as a user would run it.
+  std::vector<std::vector<cv::Point2f>> corners;
+  for (const std::string& f : files) {
+    const cv::Mat gray = cv::imread(f, cv::IMREAD_GRAYSCALE);
+    std::vector<cv::Point2f> c;
+    ASSERT_TRUE(cv::findChessboardCorners(gray, cv::Size(9, 6), c)) << f;
+    cv::cornerSubPix(gray, c, cv::Size(5, 5), cv::Size(-1, -1),
+                     cv::TermCriteria(cv::TermCriteria::EPS + cv::TermCriteria::COUNT, 50, 1e-4));
+    corners.push_back(c);
+  }
+  std::vector<cv::Point3f> model;
+  for (int y = 0; y < 6; ++y)
+    for (int x = 0; x < 9; ++x) model.emplace_back(0.025f * x, 0.025f * y, 0.0f);
+  double sum_sq = 0.0;
+  for (size_t out = 0; out < corners.size(); ++out) {
+    std::vector<std::vector<cv::Point3f>> object;
+    std::vector<std::vector<cv::Point2f>> image;
+    for (size_t v = 0; v < corners.size(); ++v)
+      if (v != out) {
+        object.push_back(model);
+        image.push_back(corners[v]);
+      }
+    cv::Mat k, dist, rvec, tvec;
+    std::vector<cv::Mat> rvecs, tvecs;
+    cv::calibrateCamera(object, image, cv::Size(640, 480), k, dist, rvecs, tvecs);
+    cv::solvePnP(model, corners[out], k, dist, rvec, tvec);
+    std::vector<cv::Point2f> projected;
+    cv::projectPoints(model, rvec, tvec, k, dist, projected);
+    for (size_t c = 0; c < model.size(); ++c)
+      sum_sq += std::pow(cv::norm(projected[c] - corners[out][c]), 2) / model.size();
+  }
+  const double opencv = std::sqrt(sum_sq / corners.size());
+  std::printf("held out of the fit: ceilpose %.3f px RMS, OpenCV calibrateCamera %.3f px\n", ours,
+              opencv);
+  // Measured: 0.201 px both (13 photographs).
+  EXPECT_LE(ours, opencv + 1e-3) << r.err;
+  EXPECT_LT(ours, 0.25) << r.err;
+  auto camera = read_camera_info_file(path("camera.yaml"));
+  ASSERT_TRUE(camera) << camera.error().message;
+  EXPECT_NEAR(camera->fx, 533.0, 3.0);
+  EXPECT_NEAR(camera->cx, 342.5, 3.0);
+}
+
+TEST_F(Calibrate, CameraFromTwelveIdenticalViewsIsRefusedAndTheOldFileIsKept) {
+  const std::string photo = std::string(kOpenCvPhotos) + "/left01.jpg";
+  ASSERT_TRUE(fs::exists(photo)) << photo << ": run scripts/setup (opencv-doc)";
+  write_photo_recording(dir_ / "same", std::vector<std::string>(12, photo));
+  const std::string old = write("camera.yaml", "an older calibration\n");
+  auto r = run_ceilposectl({"calibrate", "camera", "--replay", path("same"), "--board",
+                            "checkerboard:9x6:0.025", "--out", old},
+                           kSlowMs);
+  EXPECT_EQ(r.exit_code, 1) << r.err;
+  EXPECT_NE(r.err.find("11 of them repeating another view"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("1 distinct"), std::string::npos) << r.err;
+  std::ifstream in(old);
+  EXPECT_EQ(std::string(std::istreambuf_iterator<char>(in), {}), "an older calibration\n");
+}
+
+TEST_F(Calibrate, NoCalibrationWritesOverItsOwnInput) {
+  const std::string photo = std::string(kOpenCvPhotos) + "/left01.jpg";
+  ASSERT_TRUE(fs::exists(photo)) << photo << ": run scripts/setup (opencv-doc)";
+  write_photo_recording(dir_ / "rec", {photo});
+  const std::string yaml = path("rec/recording.yaml");
+  auto camera = run_ceilposectl({"calibrate", "camera", "--replay", path("rec"), "--board",
+                                 "checkerboard:9x6:0.025", "--out", yaml},
+                                kSlowMs);
+  EXPECT_EQ(camera.exit_code, 2) << camera.err;
+  EXPECT_NE(camera.err.find("is inside --replay"), std::string::npos) << camera.err;
+  const std::string config = write("robot.yaml", "mount:\n  lens_height_m: 0.3048\n");
+  auto mount = run_ceilposectl(
+      {"calibrate", "mount", "--replay", path("rec"), "--config", config, "--out", config},
+      kSlowMs);
+  EXPECT_EQ(mount.exit_code, 2) << mount.err;
+  EXPECT_NE(mount.err.find("--out " + config + " is --config's file"), std::string::npos)
+      << mount.err;
+  auto survey = run_ceilposectl({"survey", "--replay", path("rec"), "--intrinsics", "--out",
+                                 path("x.yaml"), "--camera-out", path("x.yaml")},
+                                kSlowMs);
+  EXPECT_EQ(survey.exit_code, 2) << survey.err;
+  EXPECT_NE(survey.err.find("are both"), std::string::npos) << survey.err;
+  std::ifstream in(config);
+  EXPECT_EQ(std::string(std::istreambuf_iterator<char>(in), {}),
+            "mount:\n  lens_height_m: 0.3048\n");
+  EXPECT_TRUE(fs::exists(yaml));
 }
 
 TEST_F(Calibrate, MountFromTurnsAndDrivesIsWithinAMillimetre) {
