@@ -334,6 +334,30 @@ std::vector<NamedPath> replay_input_files(const ReplayArgs& replay) {
           {"--map", replay.calibration.map_file}};
 }
 
+// What the estimate read the drive as, segment by segment, and what it used.
+void print_mount_report(const MountEstimate& m, const std::vector<CameraSample>& samples) {
+  for (const MotionSegment& g : m.segments) {
+    std::fprintf(stderr, "  %6.2f-%6.2f s  %-40s", samples[g.first].t_s - samples.front().t_s,
+                 samples[g.last].t_s - samples.front().t_s, to_string(g.kind));
+    if (g.kind == MotionSegment::kStraight || g.kind == MotionSegment::kStraightBackwards)
+      std::fprintf(stderr, " %.2f m, line RMS %.2f mm\n", g.length_m, 1000.0 * g.rms_m);
+    else
+      std::fprintf(stderr, " %.0f deg, camera circle radius %.1f mm, RMS %.2f mm\n",
+                   g.turned_rad * kDeg, 1000.0 * g.radius_m, 1000.0 * g.rms_m);
+  }
+  std::fprintf(stderr,
+               "calibrate mount: used %d turns in place (%.0f deg, camera circle RMS %.2f mm), %d "
+               "straight drives (%.2f m, line RMS %.2f mm)\n",
+               m.turn_segments, m.turned_rad * kDeg, 1000.0 * m.circle_rms_m, m.straight_segments,
+               m.driven_m, 1000.0 * m.line_rms_m);
+  if (m.backwards_m > 0.0)
+    std::fprintf(stderr,
+                 "calibrate mount: %.2f m of the straight drive went backwards (the image top "
+                 "pointed against the motion); taken as reversing: the image top faces the "
+                 "robot's forward axis (SPEC §3)\n",
+                 m.backwards_m);
+}
+
 void run_calibrate_mount(MountArgs& args) {
   if (auto clash =
           check_outputs_are_not_inputs({{"--out", args.out_file}}, replay_input_files(args.replay),
@@ -359,11 +383,7 @@ void run_calibrate_mount(MountArgs& args) {
     std::fprintf(stderr, "ceilposectl calibrate mount: %s\n", m.error().message.c_str());
     return set_exit_code(kExitFailure);
   }
-  std::fprintf(stderr,
-               "calibrate mount: %d turns in place (%.0f deg, camera circle RMS %.2f mm), %d "
-               "straight drives (%.2f m, line RMS %.2f mm)\n",
-               m->turn_segments, m->turned_rad * kDeg, 1000.0 * m->circle_rms_m,
-               m->straight_segments, m->driven_m, 1000.0 * m->line_rms_m);
+  print_mount_report(*m, track.samples);
   std::fprintf(stderr,
                "calibrate mount: camera %.1f +- %.1f mm forward, %.1f +- %.1f mm left of the "
                "robot origin, turned %.3f +- %.3f deg\n",
