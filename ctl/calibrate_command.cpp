@@ -15,8 +15,10 @@
 #include "calibration/board_spec.h"
 #include "calibration/camera_info_file.h"
 #include "calibration/mount_estimate.h"
+#include "calibration/mount_fragment.h"
 #include "core/output_guard.h"
 #include "core/text_file.h"
+#include "ctl/calibrate_robot_command.h"
 #include "ctl/calibration_options.h"
 #include "ctl/command_registry.h"
 #include "ctl/replay_run.h"
@@ -389,15 +391,19 @@ void run_calibrate_mount(MountArgs& args) {
                "robot origin, turned %.3f +- %.3f deg\n",
                1000.0 * m->offset_forward_m, 1000.0 * m->sigma_forward_m, 1000.0 * m->offset_left_m,
                1000.0 * m->sigma_left_m, m->yaw_rad * kDeg, m->sigma_yaw_rad * kDeg);
-  char text[512];
-  std::snprintf(text, sizeof text,
-                "# ceilposectl calibrate mount --replay %s: %d turns in place (%.0f deg), %.2f m "
-                "straight.\n# Use as --config (or merge into the configuration's mount: section).\n"
-                "mount:\n  offset_forward_m: %.5f   # +- %.5f\n  offset_left_m: %.5f      # +- "
-                "%.5f\n  yaw_rad: %.6f            # +- %.6f\n",
-                args.replay.dir.c_str(), m->turn_segments, m->turned_rad * kDeg, m->driven_m,
-                m->offset_forward_m, m->sigma_forward_m, m->offset_left_m, m->sigma_left_m,
-                m->yaw_rad, m->sigma_yaw_rad);
+  MountFragment fragment;
+  fragment.comment = "ceilposectl calibrate mount --replay " + args.replay.dir + ": " +
+                     std::to_string(m->turn_segments) + " turns in place (" +
+                     std::to_string(std::lround(m->turned_rad * kDeg)) + " deg), " +
+                     std::to_string(m->straight_segments) + " straight drives.";
+  fragment.mount = setup.config.mount;
+  fragment.mount.offset_forward_m = m->offset_forward_m;
+  fragment.mount.offset_left_m = m->offset_left_m;
+  fragment.mount.yaw_rad = m->yaw_rad;
+  fragment.sigma_forward_m = m->sigma_forward_m;
+  fragment.sigma_left_m = m->sigma_left_m;
+  fragment.sigma_yaw_rad = m->sigma_yaw_rad;
+  const std::string text = mount_fragment_text(fragment);
   if (auto wrote = replace_file(args.out_file, text); !wrote) {
     std::fprintf(stderr, "ceilposectl calibrate mount: %s\n", wrote.error().message.c_str());
     return set_exit_code(kExitFailure);
@@ -429,8 +435,10 @@ void add_calibrate_mount_command(CLI::App* calibrate) {
 }
 
 void add_calibrate_command(CLI::App& app) {
-  CLI::App* calibrate = app.add_subcommand(
-      "calibrate", "Calibrate the camera's intrinsics or its mount on the robot (SPEC §10)");
+  CLI::App* calibrate =
+      app.add_subcommand("calibrate",
+                         "Calibrate the camera's intrinsics, its mount on the robot, or both at "
+                         "once under a surveyed ceiling (SPEC §10)");
   calibrate->require_subcommand(1);
   auto cam = std::make_shared<CameraArgs>();
   CLI::App* camera = calibrate->add_subcommand(
@@ -449,6 +457,7 @@ void add_calibrate_command(CLI::App& app) {
   camera->add_option("--out", cam->out_file, "camera_info file to write")->capture_default_str();
   camera->callback([cam] { run_calibrate_camera(*cam); });
   add_calibrate_mount_command(calibrate);
+  add_calibrate_robot_command(calibrate);
 }
 
 const CommandRegistrar kReg{"calibrate", &add_calibrate_command};

@@ -18,6 +18,7 @@
 #include "ctl/calibration_options.h"
 #include "ctl/command_registry.h"
 #include "ctl/replay_run.h"
+#include "ctl/survey_frames.h"
 #include "survey/bundle_adjustment.h"
 
 namespace ceilpose::ctl {
@@ -34,27 +35,6 @@ struct SurveyArgs {
   bool intrinsics = false;
   double prior_sigma_mm = 50.0;
   int threads = 1;
-};
-
-// Every frame with a pose of its own against the nominal grid, with its
-// whole decoded markers: the survey's observations.
-class SurveyCollector final : public PoseSink {
- public:
-  explicit SurveyCollector(std::vector<SurveyFrame>* frames) : frames_(frames) {}
-  void consume(const Localization& loc) override {
-    ++seen_;
-    if (!loc.measured.valid) return;
-    SurveyFrame f;
-    f.robot = loc.measured.pose;
-    for (const MarkerObservation& m : loc.markers)
-      if (m.whole) f.markers.push_back(m);
-    frames_->push_back(std::move(f));
-    ++with_pose_;
-  }
-  size_t seen_ = 0, with_pose_ = 0;
-
- private:
-  std::vector<SurveyFrame>* frames_;
 };
 
 void print_summary(const SurveyReport& r, const SurveyArgs& args, double grid_m) {
@@ -106,42 +86,12 @@ void print_summary(const SurveyReport& r, const SurveyArgs& args, double grid_m)
                  r.groups, args.prior_sigma_mm);
 }
 
-// Decodes every frame of every recording with `camera` (empty: each
-// recording's own, or --camera's): the survey's observations. Returns the
-// exit code; *config is the first recording's pipeline configuration.
-int collect(const SurveyArgs& args, const CameraIntrinsics* camera, PipelineConfig* config,
-            std::vector<SurveyFrame>* frames) {
-  frames->clear();
-  bool first = true;
-  for (const std::string& dir : args.dirs) {
-    ReplayArgs replay;
-    replay.dir = dir;
-    replay.config_file = args.config_file;
-    replay.calibration.camera_file = args.camera_file;
-    replay.mode_text = "lsq";
-    ReplaySetup setup;
-    int rc = prepare_replay(replay, "survey", &setup);
-    if (rc != kExitOk) return rc;
-    setup.config.map.reset();  // a survey starts from the nominal grid, never from a map
-    if (camera != nullptr) setup.config.intrinsics = *camera;
-    if (first) {
-      *config = setup.config;
-    } else if (!(setup.config.intrinsics == config->intrinsics)) {
-      std::fprintf(stderr,
-                   "ceilposectl survey: %s: its camera differs from %s's: survey one camera at a "
-                   "time\n",
-                   dir.c_str(), args.dirs.front().c_str());
-      return kExitBadInput;
-    }
-    first = false;
-    SurveyCollector collector(frames);
-    PoseSink* sinks[] = {&collector};
-    rc = run_replay(replay, "survey", setup, sinks);
-    if (rc != kExitOk) return rc;
-    std::fprintf(stderr, "survey: %s: %zu frames, %zu with a pose of their own\n", dir.c_str(),
-                 collector.seen_, collector.with_pose_);
-  }
-  return kExitOk;
+FrameSources sources_of(const SurveyArgs& args) {
+  FrameSources sources;
+  sources.dirs = args.dirs;
+  sources.config_file = args.config_file;
+  sources.calibration.camera_file = args.camera_file;
+  return sources;
 }
 
 void run_survey(const SurveyArgs& args) {
@@ -156,7 +106,9 @@ void run_survey(const SurveyArgs& args) {
   }
   std::vector<SurveyFrame> frames;
   PipelineConfig config;
-  if (int rc = collect(args, nullptr, &config, &frames); rc != kExitOk) return set_exit_code(rc);
+  if (int rc = collect_survey_frames(sources_of(args), "survey", nullptr, &config, &frames);
+      rc != kExitOk)
+    return set_exit_code(rc);
   SurveyOptions options;
   options.prior_sigma_m = args.prior_sigma_mm / 1000.0;
   options.estimate_intrinsics = args.intrinsics;
@@ -176,7 +128,9 @@ void run_survey(const SurveyArgs& args) {
     const CameraIntrinsics found = report->intrinsics;
     std::fprintf(stderr, "survey: decoding again with the camera found (fx %.2f px, k1 %.4f)\n",
                  found.fx, found.distortion[0]);
-    if (int rc = collect(args, &found, &config, &frames); rc != kExitOk) return set_exit_code(rc);
+    if (int rc = collect_survey_frames(sources_of(args), "survey", &found, &config, &frames);
+        rc != kExitOk)
+      return set_exit_code(rc);
     report = survey_ceiling(config, frames, options);
     if (tty) std::fputc('\n', stderr);
   }

@@ -1,5 +1,6 @@
 #include "sim/scenarios.h"
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <numbers>
@@ -262,7 +263,60 @@ Result<ScenarioFrame> mount_drive(Context& c) {
   return fr;
 }
 
-constexpr std::array<Entry, 21> kEntries{{
+// A robot's commissioning drive (`calibrate robot`): 30 s of straight runs,
+// arcs (turning while driving, radius 0.4-0.7 m), a turn in place of 372°
+// and one of -172°, and a pause, centred under the grid; frames spread
+// evenly over it, read noise 2. The primitives as (speed m/s, turn rad/s,
+// seconds).
+struct Motion {
+  double v_mps, w_radps, duration_s;
+};
+constexpr Motion kRobotDrive[] = {{0.25, 0.0, 3.0}, {0.25, 0.4, 3.0},  {0.0, 1.0, 6.5},
+                                  {0.25, 0.0, 3.0}, {0.2, -0.5, 3.5},  {0.0, -1.0, 3.0},
+                                  {0.25, 0.0, 3.0}, {0.25, 0.35, 3.0}, {0.0, 0.0, 2.0}};
+
+// The drive's pose t_s after its start, from (0, 0, 0) (exact unicycle).
+Pose2D drive_by_motions(double t_s) {
+  Pose2D p{0.0, 0.0, 0.0};
+  for (const Motion& m : kRobotDrive) {
+    const double dt = std::min(t_s, m.duration_s);
+    const double th1 = p.yaw_rad + m.w_radps * dt;
+    if (m.w_radps == 0.0) {
+      p.x_m += m.v_mps * dt * std::cos(p.yaw_rad);
+      p.y_m += m.v_mps * dt * std::sin(p.yaw_rad);
+    } else {
+      const double r = m.v_mps / m.w_radps;
+      p.x_m += r * (std::sin(th1) - std::sin(p.yaw_rad));
+      p.y_m -= r * (std::cos(th1) - std::cos(p.yaw_rad));
+    }
+    p.yaw_rad = th1;
+    t_s -= dt;
+    if (t_s <= 0.0) break;
+  }
+  p.yaw_rad = wrap_angle_rad(p.yaw_rad);
+  return p;
+}
+
+Result<ScenarioFrame> robot_drive(Context& c) {
+  double total_s = 0.0;
+  for (const Motion& m : kRobotDrive) total_s += m.duration_s;
+  double lo_x = 0.0, hi_x = 0.0, lo_y = 0.0, hi_y = 0.0;
+  for (int k = 0; k <= 300; ++k) {
+    const Pose2D p = drive_by_motions(total_s * k / 300.0);
+    lo_x = std::min(lo_x, p.x_m);
+    hi_x = std::max(hi_x, p.x_m);
+    lo_y = std::min(lo_y, p.y_m);
+    hi_y = std::max(hi_y, p.y_m);
+  }
+  Pose2D p = drive_by_motions(total_s * (c.index + 0.5) / c.frame_count);
+  p.x_m += 0.5 * c.span_m() - 0.5 * (lo_x + hi_x);
+  p.y_m += 0.5 * c.span_m() - 0.5 * (lo_y + hi_y);
+  ScenarioFrame fr = at(p);
+  fr.effects.read_noise_sigma = 2.0;
+  return fr;
+}
+
+constexpr std::array<Entry, 22> kEntries{{
     {"thesis_points",
      "the thesis's static test points (1.5,1.5) (1.5,2.0) (1.5,2.5) (2.0,2.5) (2.5,2.5) grid "
      "units, frames split evenly between them, random yaw, read noise 2",
@@ -312,6 +366,11 @@ constexpr std::array<Entry, 21> kEntries{{
      "`calibrate mount`'s drive: a 400 deg turn in place, 1.2 m straight ahead, a half turn, "
      "1.2 m back (45/15/25/15 % of the frames; render with --config for the mount), read noise 2",
      &mount_drive, nullptr},
+    {"robot_drive",
+     "`calibrate robot`'s drive: 30 s of straight runs, arcs (radius 0.4-0.7 m), turns in place "
+     "of 372 and -172 deg and a pause, centred under the grid, frames spread evenly (render with "
+     "--config for the mount, --true-camera for the camera), read noise 2",
+     &robot_drive, nullptr},
     {"survey_two_passes",
      "two survey passes that never see the same marker: North-South lanes over the western "
      "and the eastern 1.5 grid units, read noise 2",

@@ -52,16 +52,39 @@ struct Reprojection {
 // reprojections' unit: sigmas times the image points' own noise
 // (*pixel_sigma, px), so that prior and points weigh what they should.
 struct NominalPrior {
-  double x_m, y_m, inv_sigma_m, inv_sigma_rad;
+  double x_m, y_m, yaw_rad, inv_sigma_m, inv_sigma_rad;
   const double* pixel_sigma;
   template <typename T>
   bool operator()(const T* marker, T* r) const {
     r[0] = (marker[0] - x_m) * (inv_sigma_m * *pixel_sigma);
     r[1] = (marker[1] - y_m) * (inv_sigma_m * *pixel_sigma);
-    r[2] = marker[2] * (inv_sigma_rad * *pixel_sigma);
+    r[2] = (marker[2] - yaw_rad) * (inv_sigma_rad * *pixel_sigma);
     return true;
   }
 };
+
+// With a known map (`calibrate robot`): the principal point about the
+// declared one and the tilt increment about zero, 1-sigma kPrincipalPointPx
+// and kTiltRad, in the reprojections' unit as NominalPrior.
+constexpr double kPrincipalPointPx = 30.0;
+constexpr double kTiltRad = 0.035;  // 2°
+struct CameraPriors {
+  double cx_px, cy_px;
+  const double* pixel_sigma;
+  template <typename T>
+  bool operator()(const T* k, const T* tilt, T* r) const {
+    r[0] = (k[2] - cx_px) * (*pixel_sigma / kPrincipalPointPx);
+    r[1] = (k[3] - cy_px) * (*pixel_sigma / kPrincipalPointPx);
+    r[2] = tilt[0] * (*pixel_sigma / kTiltRad);
+    r[3] = tilt[1] * (*pixel_sigma / kTiltRad);
+    return true;
+  }
+};
+
+// A surveyed map's sigmas below these would hold its markers harder than
+// any survey knows them (and make the problem stiff).
+constexpr double kMinMapSigmaM = 0.0001;
+constexpr double kMinMapSigmaRad = 0.0002;
 
 struct Sighting {
   int frame;
@@ -118,8 +141,14 @@ void sort_sightings(const PipelineConfig& config, const std::vector<SurveyFrame>
       double dx = 0.0, dy = 0.0;
       view.ceiling_offset(yaw, xn, yn, &dx, &dy);
       const double x = cam.t_w[0] + dx, y = cam.t_w[1] + dy;
-      if (std::hypot(x - m.code_i * layout.grid_m, y - m.code_j * layout.grid_m) <=
-          options.duplicate_distance_m) {
+      double home_x = m.code_i * layout.grid_m, home_y = m.code_j * layout.grid_m;
+      if (options.known_map != nullptr) {
+        const MarkerPlacement* p = options.known_map->find(m.code_i, m.code_j);
+        if (p == nullptr) continue;  // a map lists what is on the ceiling (SPEC §8)
+        home_x = p->x_m;
+        home_y = p->y_m;
+      }
+      if (std::hypot(x - home_x, y - home_y) <= options.duplicate_distance_m) {
         home->push_back({f, k, m.code_j * codes + m.code_i});
         continue;
       }
@@ -338,6 +367,36 @@ void scatter_sigmas(ceres::Problem& problem, const std::vector<ceres::ResidualBl
   }
 }
 
+// With a known map: the 1-sigma of fx, fy, k1, k2 and the tilt (points'
+// variance `variance_px2`). Their covariance over every image point; the
+// points of one view share its pose, so these are lower bounds.
+Result<SurveyReport> camera_sigmas(ceres::Problem& problem, const double* intrinsics,
+                                   const double* tilt, bool intrinsics_free, double variance_px2,
+                                   int threads, SurveyReport report) {
+  ceres::Covariance::Options cov_options;
+  cov_options.algorithm_type = ceres::SPARSE_QR;
+  cov_options.num_threads = threads;
+  ceres::Covariance covariance(cov_options);
+  std::vector<std::pair<const double*, const double*>> pairs{{tilt, tilt}};
+  if (intrinsics_free) pairs.emplace_back(intrinsics, intrinsics);
+  if (!covariance.Compute(pairs, &problem))
+    return make_error(
+        "the camera's covariance could not be computed: the drive does not determine the camera "
+        "(rank-deficient problem)");
+  double t[4];
+  covariance.GetCovarianceBlock(tilt, tilt, t);
+  report.sigma_tilt_rad = {std::sqrt(variance_px2 * t[0]), std::sqrt(variance_px2 * t[3])};
+  if (intrinsics_free) {
+    double k[81];
+    covariance.GetCovarianceBlock(intrinsics, intrinsics, k);
+    const int index[6] = {0, 1, 4, 5, 2, 3};  // fx, fy, k1, k2, cx, cy
+    for (int i = 0; i < 6; ++i)
+      report.sigma_intrinsics[static_cast<size_t>(i)] =
+          std::sqrt(variance_px2 * std::max(0.0, k[index[i] * 9 + index[i]]));
+  }
+  return report;
+}
+
 }  // namespace
 
 Result<SurveyReport> survey_ceiling(const PipelineConfig& config,
@@ -364,10 +423,26 @@ Result<SurveyReport> survey_ceiling(const PipelineConfig& config,
     cameras[f] = {cam.t_w[0], cam.t_w[1],
                   wrap_angle_rad(frames[f].robot.yaw_rad + config.mount.yaw_rad)};
   }
+  // Each marker's starting place and the prior that holds it: its nominal
+  // spot with the survey's sigmas, or its mapped place with the map's.
   std::vector<std::array<double, 3>> markers(static_cast<size_t>(codes * codes));
-  for (int code = 0; code < codes * codes; ++code)
-    markers[static_cast<size_t>(code)] = {(code % codes) * layout.grid_m,
-                                          (code / codes) * layout.grid_m, 0.0};
+  std::vector<NominalPrior> priors(static_cast<size_t>(codes * codes));
+  for (int code = 0; code < codes * codes; ++code) {
+    NominalPrior& prior = priors[static_cast<size_t>(code)];
+    prior = {(code % codes) * layout.grid_m, (code / codes) * layout.grid_m,    0.0,
+             1.0 / options.prior_sigma_m,    1.0 / options.prior_sigma_yaw_rad, nullptr};
+    if (options.known_map != nullptr) {
+      if (const MarkerPlacement* p = options.known_map->find(code % codes, code / codes)) {
+        prior = {p->x_m,
+                 p->y_m,
+                 p->yaw_rad,
+                 1.0 / std::max(p->sigma_m, kMinMapSigmaM),
+                 1.0 / std::max(p->sigma_yaw_rad, kMinMapSigmaRad),
+                 nullptr};
+      }
+    }
+    markers[static_cast<size_t>(code)] = {prior.x_m, prior.y_m, prior.yaw_rad};
+  }
   std::array<double, 2> tilt{0.0, 0.0};
   // The markers' size as the detector sees it. Free, so that distances on
   // the ceiling are measured against the grid's spacing (the markers'
@@ -413,11 +488,11 @@ Result<SurveyReport> survey_ceiling(const PipelineConfig& config,
   for (int code = 0; code < codes * codes; ++code) {
     if (frames_of[static_cast<size_t>(code)] < options.min_frames) continue;
     mapped.push_back(code);
+    NominalPrior prior = priors[static_cast<size_t>(code)];
+    prior.pixel_sigma = &pixel_sigma;
     problem.AddResidualBlock(
-        new ceres::AutoDiffCostFunction<NominalPrior, 3, 3>(new NominalPrior{
-            (code % codes) * layout.grid_m, (code / codes) * layout.grid_m,
-            1.0 / options.prior_sigma_m, 1.0 / options.prior_sigma_yaw_rad, &pixel_sigma}),
-        nullptr, markers[static_cast<size_t>(code)].data());
+        new ceres::AutoDiffCostFunction<NominalPrior, 3, 3>(new NominalPrior(prior)), nullptr,
+        markers[static_cast<size_t>(code)].data());
   }
   report.frames_used = static_cast<int>(std::count(frame_used.begin(), frame_used.end(), true));
   // A level camera at a known height cannot tell a principal point (or a
@@ -427,7 +502,19 @@ Result<SurveyReport> survey_ceiling(const PipelineConfig& config,
   // off). So the survey estimates the focal lengths and the radial
   // distortion, and holds cx, cy, p1, p2 and k3 at the declared camera (a
   // checkerboard calibration measures them; `calibrate mount` the offset).
-  if (options.estimate_intrinsics) {
+  //
+  // With the markers held by a map, a strong radial distortion shows where
+  // its centre (the principal point) is, and the tilt shows in the keystone
+  // of the view; both are free, each held by a prior about the declared
+  // camera (CameraPriors) so that a lens with little distortion leaves the
+  // principal point where it was declared and the frames' positions (then
+  // the mount offset) absorb it, as they would a tilt.
+  if (options.estimate_intrinsics && options.known_map != nullptr) {
+    problem.SetManifold(intrinsics.data(), new ceres::SubsetManifold(9, {6, 7, 8}));
+    problem.AddResidualBlock(new ceres::AutoDiffCostFunction<CameraPriors, 4, 9, 2>(
+                                 new CameraPriors{k0.cx, k0.cy, &pixel_sigma}),
+                             nullptr, intrinsics.data(), tilt.data());
+  } else if (options.estimate_intrinsics) {
     problem.SetParameterBlockConstant(tilt.data());
     problem.SetManifold(intrinsics.data(), new ceres::SubsetManifold(9, {2, 3, 6, 7, 8}));
   } else {
@@ -464,6 +551,20 @@ Result<SurveyReport> survey_ceiling(const PipelineConfig& config,
     pixel_sigma = std::max(report.rms_px, 0.01);
   }
   report.solve_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  report.cameras = cameras;
+  report.used = frame_used;
+  CameraIntrinsics& k = report.intrinsics;
+  k.fx = intrinsics[0];
+  k.fy = intrinsics[1];
+  k.cx = intrinsics[2];
+  k.cy = intrinsics[3];
+  std::copy(intrinsics.begin() + 4, intrinsics.end(), k.distortion.begin());
+  report.marker_size = marker_size;
+  report.tilt_x_rad = config.mount.tilt_x_rad + tilt[0];
+  report.tilt_y_rad = config.mount.tilt_y_rad + tilt[1];
+  if (options.known_map != nullptr)
+    return camera_sigmas(problem, intrinsics.data(), tilt.data(), options.estimate_intrinsics,
+                         pixel_sigma * pixel_sigma, options.threads, std::move(report));
 
   for (int code : mapped) {
     const auto& m = markers[static_cast<size_t>(code)];
@@ -495,15 +596,6 @@ Result<SurveyReport> survey_ceiling(const PipelineConfig& config,
       report.largest_turn_code = {code % codes, code / codes};
     }
   }
-  CameraIntrinsics& k = report.intrinsics;
-  k.fx = intrinsics[0];
-  k.fy = intrinsics[1];
-  k.cx = intrinsics[2];
-  k.cy = intrinsics[3];
-  std::copy(intrinsics.begin() + 4, intrinsics.end(), k.distortion.begin());
-  report.marker_size = marker_size;
-  report.tilt_x_rad = config.mount.tilt_x_rad + tilt[0];
-  report.tilt_y_rad = config.mount.tilt_y_rad + tilt[1];
   return report;
 }
 

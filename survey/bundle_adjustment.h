@@ -8,6 +8,7 @@
 // marker. A Huber loss keeps a mis-measured point from pulling the solution;
 // a prior pulls each marker towards its nominal spot so that markers seen
 // rarely stay sane; the result is put in SPEC §8's datum. Offline only.
+#include <cstdint>
 #include <functional>
 #include <string>
 #include <vector>
@@ -23,6 +24,7 @@ namespace ceilpose {
 // One frame of a walk: its decoded whole markers and its own pose against
 // the nominal grid (the starting value; frames without one are not used).
 struct SurveyFrame {
+  int64_t timestamp_ns = 0;
   Pose2D robot;
   std::vector<MarkerObservation> markers;
 };
@@ -40,6 +42,12 @@ struct SurveyOptions {
   // another marker printed with the same code.
   double duplicate_distance_m = 0.2;
   bool estimate_intrinsics = false;  // fx, fy, k1, k2 (cx, cy, p1, p2, k3 held: see .cpp)
+  // A surveyed ceiling (`calibrate robot`): its markers start at their mapped
+  // places and are held there by priors of their own sigmas, codes it does
+  // not list are not used, the tilt and the principal point are estimated
+  // with the intrinsics (priors about the declared camera), and no map is
+  // made (the report's map stays empty).
+  const CeilingMap* known_map = nullptr;
   int max_iterations = 100;
   int threads = 1;
   // Called once per solver iteration with a one-line progress message.
@@ -75,6 +83,14 @@ struct SurveyReport {
   std::array<int, 2> largest_turn_code{};
   double tilt_x_rad = 0.0, tilt_y_rad = 0.0;  // the camera's mounting tilt found
   double marker_size = 1.0;                   // the markers' size as detected, relative to nominal
+  // Each input frame's camera as adjusted (x, y on the floor, yaw); frames
+  // without a used sighting keep their starting value and are not `used`.
+  std::vector<std::array<double, 3>> cameras;
+  std::vector<bool> used;
+  // 1-sigma of the estimated camera terms (fx, fy, k1, k2, cx, cy) and
+  // tilt, from the adjustment's covariance (known_map only; else 0).
+  std::array<double, 6> sigma_intrinsics{};
+  std::array<double, 2> sigma_tilt_rad{};
 };
 
 // Errors say why nothing could be mapped (no frame with a pose, no marker
