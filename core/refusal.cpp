@@ -25,6 +25,9 @@ constexpr std::array<RefusalText, kRefusalCount> kText{{
     {"solver_rejected", "frames the solver rejected (no convergence or large residual)"},
     {"filter_rejected", "frames measured but refused by the temporal filter"},
     {"unmapped_markers", "frames whose whole markers are all missing from the ceiling map"},
+    {"no_colour",
+     "greyscale frames (the markers are found by their red and green: a colour camera or "
+     "format is needed)"},
 }};
 
 }  // namespace

@@ -26,6 +26,7 @@ enum class Refusal : uint8_t {
   kSolverRejected,       // the solver did not converge or its residual was too large
   kFilterRejected,       // measured, but the temporal filter gave no pose
   kUnmappedMarkers,      // whole markers decoded, none of them on the ceiling map (SPEC §8)
+  kNoColour,             // a greyscale frame: the markers are found by their red and green
   kCount,
 };
 

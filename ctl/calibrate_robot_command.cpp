@@ -50,10 +50,15 @@ struct RobotArgs {
   int threads = 1;
 };
 
+// Decodes the drive with `camera` (null: the declared one) and adjusts the
+// camera against the map; the principal point's prior stays about
+// *declared (set on the first call).
 Result<SurveyReport> adjust_camera(const RobotArgs& args, const FrameSources& sources,
-                                   const CameraIntrinsics* camera, PipelineConfig* config,
-                                   std::vector<SurveyFrame>* frames, int* rc) {
+                                   const CameraIntrinsics* camera, CameraIntrinsics* declared,
+                                   PipelineConfig* config, std::vector<SurveyFrame>* frames,
+                                   int* rc) {
   *rc = collect_survey_frames(sources, "calibrate robot", camera, config, frames);
+  if (camera == nullptr) *declared = config->intrinsics;
   if (*rc != kExitOk) return make_error("");
   if (!config->map) {
     *rc = kExitUsage;
@@ -61,6 +66,7 @@ Result<SurveyReport> adjust_camera(const RobotArgs& args, const FrameSources& so
   }
   SurveyOptions options;
   options.known_map = config->map.get();
+  options.declared_camera = declared;
   options.estimate_intrinsics = true;
   options.threads = args.threads;
   const bool tty = ::isatty(STDERR_FILENO) == 1;
@@ -99,9 +105,10 @@ void run_calibrate_robot(const RobotArgs& args) {
   sources.use_map = true;
   sources.zero_mount = true;
   PipelineConfig config;
+  CameraIntrinsics declared;
   std::vector<SurveyFrame> frames;
   int rc = kExitOk;
-  auto report = adjust_camera(args, sources, nullptr, &config, &frames, &rc);
+  auto report = adjust_camera(args, sources, nullptr, &declared, &config, &frames, &rc);
   // The detector corrects its centroids for the distortion it is told of,
   // and frames of a camera far from the declared one localize badly: decode
   // again with the camera found until the frames with a pose stop growing
@@ -113,7 +120,7 @@ void run_calibrate_robot(const RobotArgs& args) {
                  "calibrate robot: decoding again with the camera found (fx %.2f, fy %.2f, cx "
                  "%.2f, cy %.2f px, k1 %.4f)\n",
                  found.fx, found.fy, found.cx, found.cy, found.distortion[0]);
-    report = adjust_camera(args, sources, &found, &config, &frames, &rc);
+    report = adjust_camera(args, sources, &found, &declared, &config, &frames, &rc);
     if (pass > 0 && frames.size() <= before) break;
   }
   if (!report) {
@@ -188,10 +195,11 @@ void run_calibrate_robot(const RobotArgs& args) {
   std::fprintf(stderr, "calibrate robot: not determined by the drive:\n");
   if (!centre_found)
     std::fprintf(stderr,
-                 "  the principal point, held near the declared one at cx %.2f, cy %.2f px (the "
-                 "lens distorts too little to show its centre): one off-centre cannot be told "
-                 "from a camera mounted off-centre, and the mount offset above absorbs it\n",
-                 k.cx, k.cy);
+                 "  the principal point: cx %.2f, cy %.2f px, held near the declared %.2f, "
+                 "%.2f px (the lens distorts too little to show its centre): one off-centre "
+                 "cannot be told from a camera mounted off-centre, and the mount offset above "
+                 "absorbs it\n",
+                 k.cx, k.cy, declared.cx, declared.cy);
   std::fprintf(stderr,
                "  the camera tilt apart from the mount offset: %.3f deg about x, %.3f deg about "
                "y (+- %.3f, %.3f deg) found; a tilt moves the view as an offset does, and the "

@@ -15,15 +15,22 @@ namespace ceilpose::ctl {
 namespace {
 
 // Frames refused for wrong heights show only "refusal":"wrong_heights"; say
-// once, after the run, what distance the markers imply instead.
+// once, after the run, what distance the markers imply instead. Greyscale
+// frames (refused "no_colour") are counted and named once too.
 class HeightsCheck final : public PoseSink {
  public:
   explicit HeightsCheck(size_t frames) { depth_scales_.reserve(frames); }
   void consume(const Localization& loc) override {
     if (loc.measured.depth_scale > 0.0) depth_scales_.push_back(loc.measured.depth_scale);
     if (loc.refusal == Refusal::kWrongHeights) ++refused_;
+    if (loc.refusal == Refusal::kNoColour) ++greyscale_;
   }
-  void warn(const char* command, const PipelineConfig& config) {
+  void warn(const char* command, const PipelineConfig& config, size_t frames) {
+    if (greyscale_ > 0)
+      std::fprintf(stderr,
+                   "ceilposectl %s: warning: %zu of %zu frames are greyscale and got no pose: the "
+                   "markers are found by their red and green (record in colour)\n",
+                   command, greyscale_, frames);
     if (refused_ == 0 || depth_scales_.empty()) return;
     const auto mid = depth_scales_.begin() + static_cast<ptrdiff_t>(depth_scales_.size() / 2);
     std::nth_element(depth_scales_.begin(), mid, depth_scales_.end());
@@ -41,6 +48,7 @@ class HeightsCheck final : public PoseSink {
  private:
   std::vector<double> depth_scales_;
   size_t refused_ = 0;
+  size_t greyscale_ = 0;
 };
 
 }  // namespace
@@ -148,7 +156,7 @@ int run_replay(const ReplayArgs& args, const char* command, const ReplaySetup& s
       if (i + 1 == total) std::fputc('\n', stderr);
     }
   }
-  heights.warn(command, setup.config);
+  heights.warn(command, setup.config, total);
   return kExitOk;
 }
 

@@ -171,14 +171,20 @@ void Pipeline::process(const ImageView& frame, PositioningMode mode, FrameResult
   out->reconcile = ReconcileCounts{};
   rect_count_ = 0;
   pair_count_ = 0;
-  if (!usable(frame)) {
-    out->estimate = refused_estimate(Refusal::kUnusableFrame);
+  // SPEC §4 allows greyscale recordings (a checkerboard's), but the markers
+  // are red and green: such a frame is refused for what it lacks, not
+  // searched in vain for rectangles.
+  const Refusal unusable = !usable(frame)                        ? Refusal::kUnusableFrame
+                           : frame.format == PixelFormat::kGray8 ? Refusal::kNoColour
+                                                                 : Refusal::kNone;
+  if (unusable != Refusal::kNone) {
+    out->estimate = refused_estimate(unusable);
     out->total_ns = monotonic_ns() - start_ns;
     return;
   }
 
   // 1. Classify every pixel (adaptive fused lookup) and build components.
-  if (frame.format != PixelFormat::kGray8) out->unit_gains = !classifier_.adapt(frame);
+  out->unit_gains = !classifier_.adapt(frame);
   out->noisy = !labeler_.label(frame, classifier_);
   lap(kStageComponents);
 

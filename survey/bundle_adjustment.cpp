@@ -510,9 +510,11 @@ Result<SurveyReport> survey_ceiling(const PipelineConfig& config,
   // principal point where it was declared and the frames' positions (then
   // the mount offset) absorb it, as they would a tilt.
   if (options.estimate_intrinsics && options.known_map != nullptr) {
+    const CameraIntrinsics& declared =
+        options.declared_camera != nullptr ? *options.declared_camera : k0;
     problem.SetManifold(intrinsics.data(), new ceres::SubsetManifold(9, {6, 7, 8}));
     problem.AddResidualBlock(new ceres::AutoDiffCostFunction<CameraPriors, 4, 9, 2>(
-                                 new CameraPriors{k0.cx, k0.cy, &pixel_sigma}),
+                                 new CameraPriors{declared.cx, declared.cy, &pixel_sigma}),
                              nullptr, intrinsics.data(), tilt.data());
   } else if (options.estimate_intrinsics) {
     problem.SetParameterBlockConstant(tilt.data());

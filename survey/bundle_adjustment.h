@@ -48,6 +48,10 @@ struct SurveyOptions {
   // with the intrinsics (priors about the declared camera), and no map is
   // made (the report's map stays empty).
   const CeilingMap* known_map = nullptr;
+  // The camera whose principal point the known_map priors hold to (null: the
+  // configuration's). Decoding again with a camera found, the prior stays
+  // about the declared one rather than following each pass.
+  const CameraIntrinsics* declared_camera = nullptr;
   int max_iterations = 100;
   int threads = 1;
   // Called once per solver iteration with a one-line progress message.

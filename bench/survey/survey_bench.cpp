@@ -44,7 +44,8 @@ std::vector<SurveyFrame> observe(const PipelineConfig& config, const sim::LaidCe
   const double e[3] = {0.0, l.red_centre_e_m(), l.green_centre_e_m()};
   for (const sim::ScenarioFrame& f : walk->frames) {
     const CameraPose cam = camera_pose_from_robot(f.pose, config.mount);
-    SurveyFrame frame{{f.pose.x_m + 0.01 * gaussian(++noise), f.pose.y_m + 0.01 * gaussian(++noise),
+    SurveyFrame frame{f.timestamp_ns,
+                      {f.pose.x_m + 0.01 * gaussian(++noise), f.pose.y_m + 0.01 * gaussian(++noise),
                        f.pose.yaw_rad + 0.002 * gaussian(++noise)},
                       {}};
     for (int j = 0; j < laid.side(); ++j)

@@ -367,7 +367,8 @@ INSTANTIATE_TEST_SUITE_P(Recordings, IndependentLocate, ::testing::ValuesIn(loca
                          case_name);
 
 // SPEC §4 allows greyscale PNG frames, but the markers are told apart by
-// colour: `locate` must read every frame, report no pose and exit 0.
+// colour: `locate` must read every frame, report no pose with the refusal
+// no_colour, say so once, and exit 0.
 TEST(IndependentLocateGrey, GreyscalePngRecordingGivesNoPoseOnAnyFrame) {
   ScratchDir scratch;
   ASSERT_FALSE(scratch.path().empty());
@@ -386,11 +387,15 @@ TEST(IndependentLocateGrey, GreyscalePngRecordingGivesNoPoseOnAnyFrame) {
     ASSERT_EQ(first.channels(), 1) << "the frames must really be greyscale PNG";
     const LocateOutput run = run_locate(recording, fs::path(), scratch.path());
     ASSERT_EQ(run.exit_code, 0) << run.stderr_text;
-    EXPECT_EQ(run.stderr_text, "") << c.name;
+    // Said once, and on every frame (issue 27: not "no_markers").
+    EXPECT_NE(run.stderr_text.find("12 of 12 frames are greyscale"), std::string::npos)
+        << c.name << ": " << run.stderr_text;
     ASSERT_EQ(run.lines.size(), truth.size()) << run.stderr_text;
     for (const std::string& line : run.lines) {
       EXPECT_NE(line.find("\"valid\":false,\"x_m\":null,\"y_m\":null,\"yaw_rad\":null"),
                 std::string::npos)
+          << c.name << ": " << line;
+      EXPECT_NE(line.find("\"refusal\":\"no_colour\""), std::string::npos)
           << c.name << ": " << line;
       EXPECT_EQ(json_number(line, "markers"), 0.0) << c.name << ": " << line;
     }

@@ -47,7 +47,7 @@ Walk run(const std::string& scenario, int count, uint64_t seed,
         localizer.localize(image.view(), FrameInfo{f.timestamp_ns, -1, false, {}});
     accuracy.add(f.pose, true, loc.measured);
     if (!loc.measured.valid) continue;
-    SurveyFrame frame{loc.measured.pose, {}};
+    SurveyFrame frame{loc.frame.timestamp_ns, loc.measured.pose, {}};
     for (const MarkerObservation& m : loc.markers)
       if (m.whole) frame.markers.push_back(m);
     out.frames.push_back(std::move(frame));
