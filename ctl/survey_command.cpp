@@ -14,7 +14,10 @@
 
 #include "calibration/camera_info_file.h"
 #include "calibration/map_file.h"
+#include "calibration/mount_estimate.h"
+#include "calibration/mount_fragment.h"
 #include "core/output_guard.h"
+#include "core/text_file.h"
 #include "ctl/calibration_options.h"
 #include "ctl/command_registry.h"
 #include "ctl/replay_run.h"
@@ -32,6 +35,7 @@ struct SurveyArgs {
   std::string camera_file;
   std::string out_file;
   std::string camera_out_file;
+  std::string mount_out_file;
   bool intrinsics = false;
   double prior_sigma_mm = 50.0;
   int threads = 1;
@@ -98,7 +102,9 @@ void run_survey(const SurveyArgs& args) {
   std::vector<NamedPath> dirs;
   for (const std::string& dir : args.dirs) dirs.push_back({"--replay", dir});
   if (auto clash = check_outputs_are_not_inputs(
-          {{"--out", args.out_file}, {"--camera-out", args.camera_out_file}},
+          {{"--out", args.out_file},
+           {"--camera-out", args.camera_out_file},
+           {"--mount-out", args.mount_out_file}},
           {{"--config", args.config_file}, {"--camera", args.camera_file}}, dirs);
       !clash) {
     std::fprintf(stderr, "ceilposectl survey: %s\n", clash.error().message.c_str());
@@ -139,23 +145,74 @@ void run_survey(const SurveyArgs& args) {
     return set_exit_code(kExitFailure);
   }
   print_summary(*report, args, config.layout.grid_m);
+  // A walk with turns in place and straight runs also tells where the
+  // camera sits on the robot; with --intrinsics that mount also absorbs the
+  // principal point the survey held.
+  std::vector<CameraSample> track;
+  for (size_t f = 0; f < frames.size(); ++f)
+    if (report->used[f])
+      track.push_back({frames[f].timestamp_ns * 1e-9, report->cameras[f][0], report->cameras[f][1],
+                       report->cameras[f][2]});
+  auto mount = estimate_mount(track);
+  if (mount) {
+    std::fprintf(stderr,
+                 "survey: the walk's turns in place give the mount: camera %.1f +- %.1f mm "
+                 "forward, %.1f +- %.1f mm left of the robot origin, turned %.3f +- %.3f deg\n",
+                 1000.0 * mount->offset_forward_m, 1000.0 * mount->sigma_forward_m,
+                 1000.0 * mount->offset_left_m, 1000.0 * mount->sigma_left_m, kDeg * mount->yaw_rad,
+                 kDeg * mount->sigma_yaw_rad);
+  } else if (!args.mount_out_file.empty()) {
+    std::fprintf(stderr, "ceilposectl survey: --mount-out: %s; nothing was written\n",
+                 mount.error().message.c_str());
+    return set_exit_code(kExitFailure);
+  }
+  std::string held;
+  if (args.intrinsics) {
+    const CameraIntrinsics& k = report->intrinsics;
+    std::fprintf(stderr,
+                 "survey: camera: fx %.2f fy %.2f px, k1 %.5f k2 %.5f estimated; cx %.2f cy %.2f "
+                 "px, p1 %.6f p2 %.6f k3 %.5f held at the declared camera's\n",
+                 k.fx, k.fy, k.distortion[0], k.distortion[1], k.cx, k.cy, k.distortion[2],
+                 k.distortion[3], k.distortion[4]);
+    held = mount ? "a principal point off-centre cannot be told from a camera mounted "
+                   "off-centre: the mount the walk gave absorbs it; use this camera with that "
+                   "mount (--mount-out)"
+                 : "a principal point off-centre cannot be told from a camera mounted "
+                   "off-centre: the robot's origin is undetermined until `calibrate robot`, "
+                   "`calibrate mount` or a checkerboard (`calibrate camera`) fixes it";
+    std::fprintf(stderr, "survey: %s\n", held.c_str());
+  }
   if (auto wrote = write_map_file(args.out_file, report->map, config.layout); !wrote) {
     std::fprintf(stderr, "ceilposectl survey: %s\n", wrote.error().message.c_str());
     return set_exit_code(kExitFailure);
   }
   std::fprintf(stderr, "survey: wrote the map to %s\n", args.out_file.c_str());
   if (args.intrinsics) {
-    const CameraIntrinsics& k = report->intrinsics;
-    std::fprintf(stderr,
-                 "survey: camera: fx %.2f fy %.2f cx %.2f cy %.2f px, k1 %.5f k2 %.5f p1 %.6f p2 "
-                 "%.6f\n",
-                 k.fx, k.fy, k.cx, k.cy, k.distortion[0], k.distortion[1], k.distortion[2],
-                 k.distortion[3]);
-    if (auto wrote = write_camera_info_file(args.camera_out_file, k); !wrote) {
+    const std::string text =
+        "# ceilposectl survey --intrinsics: fx, fy, k1, k2 estimated; cx, "
+        "cy, p1, p2, k3 held at the declared camera's.\n# " +
+        held + ".\n" + camera_info_text(report->intrinsics, "ceilpose");
+    if (auto wrote = replace_file(args.camera_out_file, text); !wrote) {
       std::fprintf(stderr, "ceilposectl survey: %s\n", wrote.error().message.c_str());
       return set_exit_code(kExitFailure);
     }
     std::fprintf(stderr, "survey: wrote the camera to %s\n", args.camera_out_file.c_str());
+  }
+  if (mount && !args.mount_out_file.empty()) {
+    MountFragment fragment;
+    fragment.comment = "ceilposectl survey: the walk's turns in place and straight runs.";
+    fragment.mount = config.mount;
+    fragment.mount.offset_forward_m = mount->offset_forward_m;
+    fragment.mount.offset_left_m = mount->offset_left_m;
+    fragment.mount.yaw_rad = mount->yaw_rad;
+    fragment.sigma_forward_m = mount->sigma_forward_m;
+    fragment.sigma_left_m = mount->sigma_left_m;
+    fragment.sigma_yaw_rad = mount->sigma_yaw_rad;
+    if (auto wrote = replace_file(args.mount_out_file, mount_fragment_text(fragment)); !wrote) {
+      std::fprintf(stderr, "ceilposectl survey: %s\n", wrote.error().message.c_str());
+      return set_exit_code(kExitFailure);
+    }
+    std::fprintf(stderr, "survey: wrote the mount to %s\n", args.mount_out_file.c_str());
   }
   set_exit_code(kExitOk);
 }
@@ -187,6 +244,10 @@ void add_survey_command(CLI::App& app) {
                   "Where --intrinsics writes the camera (ROS camera_info YAML, SPEC §9)")
       ->needs(intrinsics);
   intrinsics->needs(cmd->get_option("--camera-out"));
+  cmd->add_option("--mount-out", args->mount_out_file,
+                  "Also write the camera's mount (configuration fragment, mount: section) that "
+                  "the walk's turns in place and straight runs give; refused (nothing written) "
+                  "when the walk has too few of them");
   cmd->add_option("--prior-sigma-mm", args->prior_sigma_mm,
                   "1-sigma of each marker about its nominal spot, mm: how far off a marker may "
                   "be glued")

@@ -8,6 +8,7 @@
 #include <cstdio>
 #include <map>
 #include <memory>
+#include <numbers>
 #include <numeric>
 
 #include "pipeline/change_of_axes.h"
@@ -202,6 +203,33 @@ int count_groups(const std::vector<Sighting>& home, int codes) {
   for (int code = 0; code < codes * codes; ++code)
     if (used[static_cast<size_t>(code)] && find_root(parent, code) == code) ++groups;
   return groups;
+}
+
+// Frames closer than this in position and yaw see the ceiling alike: one
+// viewpoint.
+constexpr double kViewpointM = 0.05;
+constexpr double kViewpointRad = 5.0 * std::numbers::pi / 180.0;
+constexpr double kDeg = 180.0 / std::numbers::pi;
+
+// Distinct viewpoints among the frames with a used sighting (greedy: a
+// frame far from every viewpoint so far is a new one).
+int count_viewpoints(const std::vector<SurveyFrame>& frames, const std::vector<Sighting>& home) {
+  std::vector<bool> used(frames.size(), false);
+  for (const Sighting& s : home) used[static_cast<size_t>(s.frame)] = true;
+  std::vector<Pose2D> views;
+  for (size_t f = 0; f < frames.size(); ++f) {
+    if (!used[f]) continue;
+    const Pose2D& p = frames[f].robot;
+    bool seen = false;
+    for (const Pose2D& v : views)
+      if (std::hypot(p.x_m - v.x_m, p.y_m - v.y_m) < kViewpointM &&
+          std::abs(wrap_angle_rad(p.yaw_rad - v.yaw_rad)) < kViewpointRad) {
+        seen = true;
+        break;
+      }
+    if (!seen) views.push_back(p);
+  }
+  return static_cast<int>(views.size());
 }
 
 double rms_px(ceres::Problem& problem, const std::vector<ceres::ResidualBlockId>& blocks) {
@@ -414,6 +442,18 @@ Result<SurveyReport> survey_ceiling(const PipelineConfig& config,
                       " frames with a pose: walk under the ceiling with the camera looking up");
   }
   report.groups = count_groups(home, codes);
+  report.viewpoints = count_viewpoints(frames, home);
+  if (report.viewpoints < options.min_viewpoints) {
+    char why[320];
+    std::snprintf(why, sizeof why,
+                  "the %zu frames saw the ceiling from %d place(s) (frames within %.0f mm and "
+                  "%.0f deg of another count as one), %d needed: a survey of a robot that did "
+                  "not move, or of one frame repeated, cannot tell the markers' places from the "
+                  "camera's errors; walk under the ceiling",
+                  frames.size(), report.viewpoints, 1000.0 * kViewpointM, kViewpointRad * kDeg,
+                  options.min_viewpoints);
+    return make_error(why);
+  }
 
   // Unknowns, at their starting values: the frames' own poses, the nominal
   // grid, the configured camera.

@@ -38,6 +38,9 @@ struct SurveyOptions {
   // residuals' own. Only the first solve's starting balance depends on it.
   double first_pixel_sigma_px = 0.25;
   int min_frames = 3;  // a marker is mapped when decoded in this many frames
+  // Fewer distinct viewpoints than this (frames within 50 mm and 5° are one)
+  // cannot separate the markers' places from the camera's errors: refused.
+  int min_viewpoints = 5;
   // A sighting farther than this from the marker's nominal spot is of
   // another marker printed with the same code.
   double duplicate_distance_m = 0.2;
@@ -77,7 +80,8 @@ struct SurveyReport {
   double solve_s = 0.0;
   double initial_rms_px = 0.0;
   double rms_px = 0.0;
-  int groups = 0;  // parts of the ceiling no frame links to the others
+  int groups = 0;      // parts of the ceiling no frame links to the others
+  int viewpoints = 0;  // distinct places the frames saw the ceiling from
   std::vector<SurveyDuplicate> duplicates;
   std::vector<std::pair<std::array<int, 2>, int>> too_rarely_seen;  // code, frames
   // Largest departures of the map from the nominal grid.

@@ -318,6 +318,36 @@ TEST_F(CalibrateRobot, ADriveWithoutATurnInPlaceIsRefusedAndWritesNothing) {
             "mount:\n  offset_forward_m: 0.1\n");
 }
 
+TEST_F(CalibrateRobot, SurveyIntrinsicsSaysTheOriginIsOpenAndRefusesAMountItCannotFind) {
+  render("drive", 120, 5, "drive");
+  auto r = run_ceilposectl(
+      {"survey", "--replay", path("drive"), "--camera", path("true_camera.yaml"), "--intrinsics",
+       "--camera-out", path("camera.yaml"), "--out", path("map.yaml")},
+      kSlowMs);
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NE(r.err.find("cx 331.50 cy 251.50 px, p1 0.000000 p2 0.000000 k3 0.00000 held"),
+            std::string::npos)
+      << r.err;
+  EXPECT_NE(r.err.find("the robot's origin is undetermined until `calibrate robot`"),
+            std::string::npos)
+      << r.err;
+  std::ifstream camera(path("camera.yaml"));
+  const std::string text(std::istreambuf_iterator<char>(camera), {});
+  EXPECT_EQ(text.rfind("# ceilposectl survey --intrinsics: fx, fy, k1, k2 estimated", 0), 0u)
+      << text;
+  EXPECT_TRUE(read_camera_info_file(path("camera.yaml")));
+  // The curving drive has no turn in place: no mount, and then nothing.
+  auto m =
+      run_ceilposectl({"survey", "--replay", path("drive"), "--camera", path("true_camera.yaml"),
+                       "--out", path("map2.yaml"), "--mount-out", path("mount.yaml")},
+                      kSlowMs);
+  EXPECT_EQ(m.exit_code, 1) << m.err;
+  EXPECT_NE(m.err.find("--mount-out: the recording lacks turning in place"), std::string::npos)
+      << m.err;
+  EXPECT_FALSE(fs::exists(path("map2.yaml")));
+  EXPECT_FALSE(fs::exists(path("mount.yaml")));
+}
+
 TEST_F(CalibrateRobot, GreyscaleFramesAreRefusedSayingTheyHaveNoColour) {
   const std::string photo = std::string(kOpenCvPhotos) + "/left01.jpg";
   ASSERT_TRUE(fs::exists(photo)) << photo << ": run scripts/setup (opencv-doc)";

@@ -196,6 +196,28 @@ TEST_F(Survey, TwoPassesThatNeverMeetAreMappedAndWarnedAbout) {
   EXPECT_GT(median_sigma, 0.002);
 }
 
+// issue 27: a survey of a robot that did not move (or of one frame
+// repeated) wrote a map whose sigmas were 100-1000x smaller than its errors.
+TEST_F(Survey, FramesFromOnePlaceAreRefusedSayingSo) {
+  const Walk walk = run("survey_walk", 40, 11, laid_, config_, config_.intrinsics);
+  ASSERT_GT(walk.frames.size(), 20u);
+  // The same frame thirty times, and thirty frames a tenth of a millimetre
+  // apart (a stationary robot's noise).
+  std::vector<SurveyFrame> same(30, walk.frames[10]);
+  std::vector<SurveyFrame> still = same;
+  for (size_t k = 0; k < still.size(); ++k) still[k].robot.x_m += 1e-4 * static_cast<double>(k);
+  for (const auto* frames : {&same, &still}) {
+    auto report = survey_ceiling(config_, *frames, options_);
+    ASSERT_FALSE(report);
+    EXPECT_NE(report.error().message.find("saw the ceiling from 1 place(s)"), std::string::npos)
+        << report.error().message;
+  }
+  // The walk those frames came from is surveyed.
+  auto report = survey_ceiling(config_, walk.frames, options_);
+  ASSERT_TRUE(report) << report.error().message;
+  EXPECT_GE(report->viewpoints, 20);
+}
+
 TEST_F(Survey, FramesThatSeeNoMarkerOftenEnoughAreAnErrorSayingWhy) {
   std::vector<SurveyFrame> frames(2);
   auto report = survey_ceiling(config_, frames, options_);
