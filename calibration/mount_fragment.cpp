@@ -39,4 +39,18 @@ std::string mount_fragment_text(const MountFragment& f) {
   return out;
 }
 
+MountFragment fragment_of(const MountEstimate& estimate, const CameraMount& base,
+                          std::string comment) {
+  MountFragment f;
+  f.comment = std::move(comment);
+  f.mount = base;
+  f.mount.offset_forward_m = estimate.offset_forward_m;
+  f.mount.offset_left_m = estimate.offset_left_m;
+  f.mount.yaw_rad = estimate.yaw_rad;
+  f.sigma_forward_m = estimate.sigma_forward_m;
+  f.sigma_left_m = estimate.sigma_left_m;
+  f.sigma_yaw_rad = estimate.sigma_yaw_rad;
+  return f;
+}
+
 }  // namespace ceilpose

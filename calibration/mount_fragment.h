@@ -5,6 +5,7 @@
 #include <array>
 #include <string>
 
+#include "calibration/mount_estimate.h"
 #include "core/camera_model.h"
 
 namespace ceilpose {
@@ -20,5 +21,10 @@ struct MountFragment {
 };
 
 std::string mount_fragment_text(const MountFragment& fragment);
+
+// `base` (the configuration's mount: lens height, tilt) with the estimate's
+// offset, yaw and sigmas.
+MountFragment fragment_of(const MountEstimate& estimate, const CameraMount& base,
+                          std::string comment);
 
 }  // namespace ceilpose

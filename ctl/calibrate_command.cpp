@@ -391,18 +391,12 @@ void run_calibrate_mount(MountArgs& args) {
                "robot origin, turned %.3f +- %.3f deg\n",
                1000.0 * m->offset_forward_m, 1000.0 * m->sigma_forward_m, 1000.0 * m->offset_left_m,
                1000.0 * m->sigma_left_m, m->yaw_rad * kDeg, m->sigma_yaw_rad * kDeg);
-  MountFragment fragment;
-  fragment.comment = "ceilposectl calibrate mount --replay " + args.replay.dir + ": " +
-                     std::to_string(m->turn_segments) + " turns in place (" +
-                     std::to_string(std::lround(m->turned_rad * kDeg)) + " deg), " +
-                     std::to_string(m->straight_segments) + " straight drives.";
-  fragment.mount = setup.config.mount;
-  fragment.mount.offset_forward_m = m->offset_forward_m;
-  fragment.mount.offset_left_m = m->offset_left_m;
-  fragment.mount.yaw_rad = m->yaw_rad;
-  fragment.sigma_forward_m = m->sigma_forward_m;
-  fragment.sigma_left_m = m->sigma_left_m;
-  fragment.sigma_yaw_rad = m->sigma_yaw_rad;
+  const MountFragment fragment =
+      fragment_of(*m, setup.config.mount,
+                  "ceilposectl calibrate mount --replay " + args.replay.dir + ": " +
+                      std::to_string(m->turn_segments) + " turns in place (" +
+                      std::to_string(std::lround(m->turned_rad * kDeg)) + " deg), " +
+                      std::to_string(m->straight_segments) + " straight drives.");
   const std::string text = mount_fragment_text(fragment);
   if (auto wrote = replace_file(args.out_file, text); !wrote) {
     std::fprintf(stderr, "ceilposectl calibrate mount: %s\n", wrote.error().message.c_str());

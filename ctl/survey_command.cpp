@@ -199,15 +199,8 @@ void run_survey(const SurveyArgs& args) {
     std::fprintf(stderr, "survey: wrote the camera to %s\n", args.camera_out_file.c_str());
   }
   if (mount && !args.mount_out_file.empty()) {
-    MountFragment fragment;
-    fragment.comment = "ceilposectl survey: the walk's turns in place and straight runs.";
-    fragment.mount = config.mount;
-    fragment.mount.offset_forward_m = mount->offset_forward_m;
-    fragment.mount.offset_left_m = mount->offset_left_m;
-    fragment.mount.yaw_rad = mount->yaw_rad;
-    fragment.sigma_forward_m = mount->sigma_forward_m;
-    fragment.sigma_left_m = mount->sigma_left_m;
-    fragment.sigma_yaw_rad = mount->sigma_yaw_rad;
+    const MountFragment fragment = fragment_of(
+        *mount, config.mount, "ceilposectl survey: the walk's turns in place and straight runs.");
     if (auto wrote = replace_file(args.mount_out_file, mount_fragment_text(fragment)); !wrote) {
       std::fprintf(stderr, "ceilposectl survey: %s\n", wrote.error().message.c_str());
       return set_exit_code(kExitFailure);
