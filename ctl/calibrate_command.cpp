@@ -313,6 +313,7 @@ void run_calibrate_camera(const CameraArgs& args) {
 struct MountArgs {
   ReplayArgs replay;
   std::string out_file = "mount.yaml";
+  MountEstimateOptions estimate;
 };
 
 // Every frame's camera pose: the robot's pose as if the camera sat at the
@@ -380,7 +381,7 @@ void run_calibrate_mount(MountArgs& args) {
   if (rc != kExitOk) return set_exit_code(rc);
   std::fprintf(stderr, "calibrate mount: %zu of %zu frames localized\n", track.samples.size(),
                setup.reader->rows().size());
-  auto m = estimate_mount(track.samples);
+  auto m = estimate_mount(track.samples, args.estimate);
   if (!m) {
     std::fprintf(stderr, "ceilposectl calibrate mount: %s\n", m.error().message.c_str());
     return set_exit_code(kExitFailure);
@@ -412,12 +413,15 @@ void add_calibrate_mount_command(CLI::App* calibrate) {
       "mount",
       "The camera's place on the robot (offset forward and left of the robot origin, mounting "
       "yaw) from a recording in which the robot turns in place (360 deg or more in total) and "
-      "drives straight forward (1 m or more): the camera circles the origin while turning and "
-      "moves along the robot's heading while driving. Prints them with their 1-sigma and writes "
-      "a configuration fragment (mount: section) usable as --config. The lens height and tilt "
-      "are the configuration's.\n"
-      "Exit 0 ok, 1 the recording lacks the turn or the drive (says which) or cannot write, 2 "
-      "usage, 4 malformed recording, configuration, map or camera file.");
+      "drives straight (1 m or more): turning in place, the camera circles a still centre (the "
+      "robot's origin); driving straight, it moves along the robot's heading. Jumps, time gaps, "
+      "pauses and changes of motion end a segment; arcs (turning while driving) and circles "
+      "about a moving centre are not used; reversing is named. Prints each segment, the mount "
+      "with its 1-sigma, and writes a configuration fragment (mount: section) usable as "
+      "--config. The lens height and tilt are the configuration's.\n"
+      "Exit 0 ok, 1 the recording lacks the turn or the drive, or determines the mount worse "
+      "than 1 mm / 0.1 deg (says which, writes nothing), or cannot write, 2 usage (also --out "
+      "being an input), 4 malformed recording, configuration, map or camera file.");
   mount->add_option("--replay", args->replay.dir, "Recording of the turns and drives")->required();
   mount->add_option("--config", args->replay.config_file,
                     "Configuration (ceiling, camera, lens height; its mount offset and yaw are "
@@ -425,6 +429,7 @@ void add_calibrate_mount_command(CLI::App* calibrate) {
   add_calibration_options(mount, &args->replay.calibration);
   mount->add_option("--out", args->out_file, "Configuration fragment to write")
       ->capture_default_str();
+  add_max_offset_option(mount, &args->estimate.max_offset_m);
   mount->callback([args] { run_calibrate_mount(*args); });
 }
 

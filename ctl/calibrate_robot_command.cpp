@@ -277,11 +277,7 @@ void add_calibrate_robot_command(CLI::App* calibrate) {
   cmd->add_option("--mount-out", args->mount_out,
                   "Configuration fragment (mount: section) to write")
       ->required();
-  cmd->add_option("--max-offset-m", args->max_offset_m,
-                  "Farthest the camera may sit from the robot's turning centre, m: a wider "
-                  "turning circle is an arc, not a turn in place")
-      ->capture_default_str()
-      ->check(CLI::Range(0.01, 2.0));
+  add_max_offset_option(cmd, &args->max_offset_m);
   cmd->add_option("--threads", args->threads, "Solver threads")
       ->capture_default_str()
       ->check(CLI::Range(1, 64));

@@ -26,4 +26,14 @@ inline void add_calibration_options(CLI::App* cmd, CalibrationFiles* files) {
   add_map_option(cmd, &files->map_file);
 }
 
+// calibrate mount and calibrate robot: how far from the turning centre a
+// camera may sit (calibration/mount_estimate.h).
+inline void add_max_offset_option(CLI::App* cmd, double* max_offset_m) {
+  cmd->add_option("--max-offset-m", *max_offset_m,
+                  "Farthest the camera may sit from the robot's turning centre, m: a wider "
+                  "turning circle is an arc (turning while driving), not a turn in place")
+      ->capture_default_str()
+      ->check(CLI::Range(0.01, 2.0));
+}
+
 }  // namespace ceilpose::ctl
