@@ -136,8 +136,14 @@ std::string camera_info_text(const CameraIntrinsics& k, const std::string& camer
 }
 
 Result<void> write_camera_info_file(const std::string& path, const CameraIntrinsics& camera,
-                                    const std::string& camera_name) {
-  return replace_file(path, camera_info_text(camera, camera_name));
+                                    const std::string& camera_name, const std::string& comment) {
+  bool finite = camera.fx > 0.0 && camera.fy > 0.0 && std::isfinite(camera.fx) &&
+                std::isfinite(camera.fy) && std::isfinite(camera.cx) && std::isfinite(camera.cy);
+  for (double d : camera.distortion) finite = finite && std::isfinite(d);
+  if (!finite)
+    return make_error(path + ": not written: the camera found is not finite (fx " +
+                      std::to_string(camera.fx) + ", fy " + std::to_string(camera.fy) + ")");
+  return replace_file(path, comment + camera_info_text(camera, camera_name));
 }
 
 Result<void> check_calibration_size(const CameraIntrinsics& calibration, const std::string& origin,

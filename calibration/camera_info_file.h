@@ -18,8 +18,12 @@ Result<CameraIntrinsics> read_camera_info_file(const std::string& path);
 // [K | 0]).
 std::string camera_info_text(const CameraIntrinsics& camera, const std::string& camera_name);
 
+// Writes the file (atomically), `comment` first (lines starting "# "); a
+// camera with a non-finite or non-positive focal length, or a non-finite
+// term, is refused and nothing is written.
 Result<void> write_camera_info_file(const std::string& path, const CameraIntrinsics& camera,
-                                    const std::string& camera_name = "ceilpose");
+                                    const std::string& camera_name = "ceilpose",
+                                    const std::string& comment = "");
 
 // SPEC §9: a calibration made at another image size is an error, not a
 // silent rescale. `origin` names the calibration, `capture` the size it must

@@ -1,6 +1,9 @@
 #include "calibration/mount_fragment.h"
 
+#include <cmath>
 #include <cstdio>
+
+#include "core/text_file.h"
 
 namespace ceilpose {
 namespace {
@@ -37,6 +40,15 @@ std::string mount_fragment_text(const MountFragment& f) {
     out += line;
   }
   return out;
+}
+
+Result<void> write_mount_fragment(const std::string& path, const MountFragment& f) {
+  const CameraMount& m = f.mount;
+  for (double v : {m.offset_forward_m, m.offset_left_m, m.yaw_rad, m.tilt_x_rad, m.tilt_y_rad,
+                   m.lens_height_m, f.sigma_forward_m, f.sigma_left_m, f.sigma_yaw_rad,
+                   f.sigma_tilt_rad[0], f.sigma_tilt_rad[1]})
+    if (!std::isfinite(v)) return make_error(path + ": not written: the mount found is not finite");
+  return replace_file(path, mount_fragment_text(f));
 }
 
 MountFragment fragment_of(const MountEstimate& estimate, const CameraMount& base,

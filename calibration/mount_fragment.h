@@ -7,6 +7,7 @@
 
 #include "calibration/mount_estimate.h"
 #include "core/camera_model.h"
+#include "core/result.h"
 
 namespace ceilpose {
 
@@ -21,6 +22,9 @@ struct MountFragment {
 };
 
 std::string mount_fragment_text(const MountFragment& fragment);
+
+// Writes it (atomically); a non-finite value is refused and nothing written.
+Result<void> write_mount_fragment(const std::string& path, const MountFragment& fragment);
 
 // `base` (the configuration's mount: lens height, tilt) with the estimate's
 // offset, yaw and sigmas.

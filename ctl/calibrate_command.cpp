@@ -17,7 +17,6 @@
 #include "calibration/mount_estimate.h"
 #include "calibration/mount_fragment.h"
 #include "core/output_guard.h"
-#include "core/text_file.h"
 #include "ctl/calibrate_robot_command.h"
 #include "ctl/calibration_options.h"
 #include "ctl/command_registry.h"
@@ -398,8 +397,7 @@ void run_calibrate_mount(MountArgs& args) {
                       std::to_string(m->turn_segments) + " turns in place (" +
                       std::to_string(std::lround(m->turned_rad * kDeg)) + " deg), " +
                       std::to_string(m->straight_segments) + " straight drives.");
-  const std::string text = mount_fragment_text(fragment);
-  if (auto wrote = replace_file(args.out_file, text); !wrote) {
+  if (auto wrote = write_mount_fragment(args.out_file, fragment); !wrote) {
     std::fprintf(stderr, "ceilposectl calibrate mount: %s\n", wrote.error().message.c_str());
     return set_exit_code(kExitFailure);
   }

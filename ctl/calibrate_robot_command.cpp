@@ -21,7 +21,6 @@
 #include "calibration/mount_estimate.h"
 #include "calibration/mount_fragment.h"
 #include "core/output_guard.h"
-#include "core/text_file.h"
 #include "ctl/calibration_options.h"
 #include "ctl/command_registry.h"
 #include "ctl/survey_frames.h"
@@ -223,8 +222,7 @@ void run_calibrate_robot(const RobotArgs& args) {
       "\n# fx, fy, k1, k2, cx, cy estimated (cx, cy only as far as the lens distortion shows "
       "them); p1, p2, k3 held. Use with the mount in " +
       args.mount_out + ": its offset absorbs what the principal point and tilt leave.\n";
-  if (auto wrote = replace_file(args.camera_out, camera_comment + camera_info_text(k, "ceilpose"));
-      !wrote) {
+  if (auto wrote = write_camera_info_file(args.camera_out, k, "ceilpose", camera_comment); !wrote) {
     std::fprintf(stderr, "%s: %s\n", kCmd, wrote.error().message.c_str());
     return set_exit_code(kExitFailure);
   }
@@ -237,7 +235,7 @@ void run_calibrate_robot(const RobotArgs& args) {
   fragment.mount.tilt_y_rad = r.tilt_y_rad;
   fragment.with_tilt_and_height = true;
   fragment.sigma_tilt_rad = r.sigma_tilt_rad;
-  if (auto wrote = replace_file(args.mount_out, mount_fragment_text(fragment)); !wrote) {
+  if (auto wrote = write_mount_fragment(args.mount_out, fragment); !wrote) {
     std::fprintf(stderr, "%s: %s\n", kCmd, wrote.error().message.c_str());
     return set_exit_code(kExitFailure);
   }

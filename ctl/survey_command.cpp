@@ -17,7 +17,6 @@
 #include "calibration/mount_estimate.h"
 #include "calibration/mount_fragment.h"
 #include "core/output_guard.h"
-#include "core/text_file.h"
 #include "ctl/calibration_options.h"
 #include "ctl/command_registry.h"
 #include "ctl/replay_run.h"
@@ -191,8 +190,10 @@ void run_survey(const SurveyArgs& args) {
     const std::string text =
         "# ceilposectl survey --intrinsics: fx, fy, k1, k2 estimated; cx, "
         "cy, p1, p2, k3 held at the declared camera's.\n# " +
-        held + ".\n" + camera_info_text(report->intrinsics, "ceilpose");
-    if (auto wrote = replace_file(args.camera_out_file, text); !wrote) {
+        held + ".\n";
+    if (auto wrote =
+            write_camera_info_file(args.camera_out_file, report->intrinsics, "ceilpose", text);
+        !wrote) {
       std::fprintf(stderr, "ceilposectl survey: %s\n", wrote.error().message.c_str());
       return set_exit_code(kExitFailure);
     }
@@ -201,7 +202,7 @@ void run_survey(const SurveyArgs& args) {
   if (mount && !args.mount_out_file.empty()) {
     const MountFragment fragment = fragment_of(
         *mount, config.mount, "ceilposectl survey: the walk's turns in place and straight runs.");
-    if (auto wrote = replace_file(args.mount_out_file, mount_fragment_text(fragment)); !wrote) {
+    if (auto wrote = write_mount_fragment(args.mount_out_file, fragment); !wrote) {
       std::fprintf(stderr, "ceilposectl survey: %s\n", wrote.error().message.c_str());
       return set_exit_code(kExitFailure);
     }
