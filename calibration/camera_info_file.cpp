@@ -83,6 +83,16 @@ Result<CameraIntrinsics> read_camera_info_file(const std::string& path) {
   k.cx = m[2];
   k.fy = m[4];
   k.cy = m[5];
+  // A principal point outside the image is no lens (issue 28: every pose
+  // came out valid and 11.6 m off).
+  if (!(k.cx >= 0.0 && k.cx <= k.width - 1.0 && k.cy >= 0.0 && k.cy <= k.height - 1.0)) {
+    char msg[200];
+    std::snprintf(msg, sizeof msg,
+                  ": camera_matrix's principal point (%.6g, %.6g) px lies outside the %d x %d "
+                  "image",
+                  k.cx, k.cy, k.width, k.height);
+    return make_error(where(path, (*root)["camera_matrix"]) + msg);
+  }
   // Absent, distortion_model is plumb_bob: the five coefficients SPEC §9
   // reads can mean nothing else (docs/decisions.md).
   const YAML::Node model = (*root)["distortion_model"];

@@ -22,6 +22,22 @@ constexpr const char* kSigmaYaw = "sigma_yaw_rad";
 constexpr const char* kObservations = "observations";
 }  // namespace key
 
+// Sigmas beyond these describe no marker (issue 28: 1e154 gave NaN
+// covariances downstream): a map entry is known to a grid unit or better.
+constexpr double kMaxMapSigmaM = 1.0;
+constexpr double kMaxMapSigmaRad = 3.141592653589793;
+// SPEC §8's datum, as read: the best rigid fit of the centres onto the
+// nominal grid may differ from the identity by rounding and hand edits,
+// not by a moved or turned map.
+constexpr double kDatumShiftM = 0.005;
+constexpr double kDatumTurnRad = 0.1 * 3.141592653589793 / 180.0;
+
+std::string shown_number(double v) {
+  char t[32];
+  std::snprintf(t, sizeof t, "%.6g", v);
+  return t;
+}
+
 // The map's ceiling must be the configured one: a map surveyed under another
 // height or grid would place every marker wrongly without any error.
 Result<void> check_ceiling(const std::string& path, const YAML::Node& root,
@@ -93,15 +109,21 @@ Result<void> read_marker(const std::string& path, const YAML::Node& node, size_t
     double* dst;
     const double* fallback;
     bool non_negative;
+    const double* limit;
   };
-  for (const Field& f :
-       {Field{key::kX, &p.x_m, nullptr, false}, Field{key::kY, &p.y_m, nullptr, false},
-        Field{key::kYaw, &p.yaw_rad, &zero, false}, Field{key::kSigma, &p.sigma_m, &zero, true},
-        Field{key::kSigmaYaw, &p.sigma_yaw_rad, &zero, true}}) {
+  for (const Field& f : {Field{key::kX, &p.x_m, nullptr, false, nullptr},
+                         Field{key::kY, &p.y_m, nullptr, false, nullptr},
+                         Field{key::kYaw, &p.yaw_rad, &zero, false, nullptr},
+                         Field{key::kSigma, &p.sigma_m, &zero, true, &kMaxMapSigmaM},
+                         Field{key::kSigmaYaw, &p.sigma_yaw_rad, &zero, true, &kMaxMapSigmaRad}}) {
     auto v = finite_number(path, node, f.key, entry + "." + f.key, f.fallback);
     if (!v) return v.error();
     if (f.non_negative && *v < 0.0)
       return make_error(where(path, node[f.key]) + ": " + entry + "." + f.key + " is negative");
+    if (f.limit != nullptr && *v > *f.limit)
+      return make_error(where(path, node[f.key]) + ": " + entry + "." + f.key + " is " +
+                        shown_number(*v) + ", over " + shown_number(*f.limit) +
+                        ": a marker known no better than that is not mapped");
     *f.dst = *v;
   }
   const int none = 0;
@@ -158,6 +180,20 @@ static Result<CeilingMap> read_map(const std::string& path, const CeilingLayout&
   CeilingMap map = CeilingMap::empty(layout);
   for (size_t k = 0; k < markers.size(); ++k) {
     if (auto read = read_marker(path, markers[k], k, &map); !read) return read.error();
+  }
+  const PlaneMotion datum = datum_motion(map, layout);
+  if (std::hypot(datum.tx_m, datum.ty_m) > kDatumShiftM ||
+      std::abs(datum.rotation_rad) > kDatumTurnRad) {
+    char msg[320];
+    std::snprintf(msg, sizeof msg,
+                  ": the map breaks SPEC §8's datum: the best rigid fit of its %d centres onto "
+                  "the nominal grid moves them by (%.1f, %.1f) mm and turns them by %.3f deg "
+                  "(limits %.0f mm, %.1f deg); a survey writes maps in the datum, a map moved or "
+                  "turned by hand must be moved back",
+                  map.present_count(), 1000.0 * datum.tx_m, 1000.0 * datum.ty_m,
+                  datum.rotation_rad * 180.0 / 3.141592653589793, 1000.0 * kDatumShiftM,
+                  kDatumTurnRad * 180.0 / 3.141592653589793);
+    return make_error(path + msg);
   }
   return map;
 }

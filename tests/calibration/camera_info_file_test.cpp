@@ -108,7 +108,11 @@ INSTANTIATE_TEST_SUITE_P(
                 "rectification_matrix must be the identity"},
         BadInfo{"ProjectionOfThreeValues",
                 replaced("rows: 3, cols: 4, data: [", "rows: 1, cols: 3, data: ["),
-                "'projection_matrix' must be a 3 x 4 matrix"}),
+                "'projection_matrix' must be a 3 x 4 matrix"},
+        // Issue 28, defect 3: every pose came out valid and 11.6 m off.
+        BadInfo{"PrincipalPointOutsideTheImage",
+                replaced("531.0, 239.5, 0.0, 0.0, 1.0]}", "531.0, 5000.0, 0.0, 0.0, 1.0]}"),
+                "principal point (319.5, 5000) px lies outside the 640 x 480 image"}),
     [](const auto& info) { return std::string(info.param.name); });
 
 TEST(CalibrationFiles, ACameraOfAnotherSizeIsAnErrorNotARescale) {

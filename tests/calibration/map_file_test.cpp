@@ -83,6 +83,21 @@ TEST_P(MalformedMap, IsRejectedNamingFileLineAndEntry) {
 
 const std::string kOne = "  - code: [1, 2]\n    x_m: 0.61\n    y_m: 1.22\n";
 
+// The whole nominal grid moved by (dx, dy) and turned by turn_deg about the
+// origin: a map out of SPEC §8's datum.
+std::string moved_grid(double dx_m, double dy_m, double turn_deg) {
+  std::string out = kHeader;
+  const double c = std::cos(turn_deg * M_PI / 180.0), s = std::sin(turn_deg * M_PI / 180.0);
+  for (int j = 0; j < 8; ++j)
+    for (int i = 0; i < 8; ++i) {
+      const double x = i * 0.6096, y = j * 0.6096;
+      out += "  - code: [" + std::to_string(i) + ", " + std::to_string(j) +
+             "]\n    x_m: " + std::to_string(c * x - s * y + dx_m) +
+             "\n    y_m: " + std::to_string(s * x + c * y + dy_m) + "\n";
+    }
+  return out;
+}
+
 INSTANTIATE_TEST_SUITE_P(
     Kinds, MalformedMap,
     ::testing::Values(
@@ -123,6 +138,14 @@ INSTANTIATE_TEST_SUITE_P(
                "format: ceilpose-map\nversion: 1\nceiling:\n  height_m: 3.0\nmarkers:\n" + kOne,
                "ceiling.height_m is 3.000000 m but the configuration's ceiling.height_m is "
                "2.438400 m"},
+        // Issue 28, defect 4: 1e154 gave valid poses with a NaN covariance.
+        BadMap{"HugeSigma", std::string(kHeader) + kOne + "    sigma_m: 1e154\n",
+               "markers[0] (code [1, 2]).sigma_m is 1e+154, over 1: a marker known no better"},
+        // Issue 28, defect 5: a moved or turned map moved every pose with it.
+        BadMap{"Shifted", moved_grid(1.0, 0.0, 0.0),
+               "breaks SPEC §8's datum: the best rigid fit of its 64 centres onto the nominal "
+               "grid moves them by (-1000.0, "},
+        BadMap{"Turned", moved_grid(0.0, 0.0, 10.0), "turns them by -10.000 deg"},
         BadMap{"NoMarkers", "format: ceilpose-map\nversion: 1\nmarkers: []\n",
                "key 'markers' must be a non-empty list"},
         BadMap{"Empty", "", ":1: expected a YAML mapping"}),
