@@ -9,6 +9,7 @@
 #include <charconv>
 #include <cmath>
 #include <cstring>
+#include <filesystem>
 #include <fstream>
 #include <set>
 #include <sstream>
@@ -357,7 +358,16 @@ Result<ServiceConfig> load_config_string(const std::string& yaml_text, const std
 Result<ServiceConfig> load_config_file(const std::string& path) {
   auto text = read_text_file(path, "configuration file");
   if (!text) return text.error();
-  return parse(*text, path, nullptr);
+  auto config = parse(*text, path, nullptr);
+  if (!config) return config;
+  // A relative camera.calibration_file or ceiling.map names a file beside
+  // the configuration, wherever the command runs (issue 28: they resolved
+  // against the current directory, so --check-config answered by cwd).
+  const std::filesystem::path dir = std::filesystem::path(path).parent_path();
+  for (std::string* file : {&config->calibration.camera_file, &config->calibration.map_file})
+    if (!file->empty() && std::filesystem::path(*file).is_relative() && !dir.empty())
+      *file = (dir / *file).lexically_normal().string();
+  return config;
 }
 
 Result<ServiceConfig> with_calibration_files(ServiceConfig config) {

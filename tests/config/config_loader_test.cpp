@@ -2,8 +2,10 @@
 // path, what was expected and what was found.
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
+#include <unistd.h>
 
 #include <cstdio>
+#include <filesystem>
 #include <fstream>
 
 #include "config/service_config.h"
@@ -182,6 +184,33 @@ TEST(ConfigDiff, NamesExactlyTheChangedKeys) {
   changed.capture.device.fps = 60.0;
   EXPECT_EQ(changed_config_keys(default_config(), changed),
             (std::vector<std::string>{"detector.min_rect_area_px", "capture.fps"}));
+}
+
+}  // namespace
+}  // namespace ceilpose
+
+namespace ceilpose {
+namespace {
+
+// Issue 28, defect 6: relative calibration paths resolved against the
+// current directory, so another directory's map.yaml was used silently.
+TEST(ConfigLoader, RelativeMapAndCameraFilesAreBesideTheConfiguration) {
+  const std::filesystem::path dir = std::filesystem::path(::testing::TempDir()) /
+                                    ("ceilpose-relative-" + std::to_string(getpid()));
+  std::filesystem::create_directories(dir / "robot");
+  const std::filesystem::path file = dir / "robot" / "ceilpose.yaml";
+  std::ofstream(file)
+      << "camera:\n  calibration_file: cam.yaml\nceiling:\n  map: ../maps/lab.yaml\n";
+  auto config = load_config_file(file.string());
+  ASSERT_TRUE(config) << config.error().message;
+  EXPECT_EQ(config->calibration.camera_file, (dir / "robot" / "cam.yaml").string());
+  EXPECT_EQ(config->calibration.map_file, (dir / "maps" / "lab.yaml").string());
+  // Absolute paths stay as written.
+  std::ofstream(file) << "ceiling:\n  map: /etc/ceilpose/map.yaml\n";
+  config = load_config_file(file.string());
+  ASSERT_TRUE(config) << config.error().message;
+  EXPECT_EQ(config->calibration.map_file, "/etc/ceilpose/map.yaml");
+  std::filesystem::remove_all(dir);
 }
 
 }  // namespace
