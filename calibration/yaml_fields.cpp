@@ -16,6 +16,7 @@ std::string where(const std::string& path, const YAML::Node& node) {
 Result<YAML::Node> load_yaml_mapping(const std::string& path, const char* what) {
   auto text = read_text_file(path, what, size_t{64} << 20);
   if (!text) return text.error();
+  if (auto plain = check_no_aliases(*text, path); !plain) return plain.error();
   YAML::Node root;
   try {
     root = YAML::Load(*text);

@@ -19,6 +19,7 @@
 
 #include "config/config_schema.h"
 #include "core/text_file.h"
+#include "core/yaml_duplicate_keys.h"
 
 namespace ceilpose {
 namespace {
@@ -337,6 +338,7 @@ Result<ServiceConfig> read_tree(const YAML::Node& root, const ServiceConfig& bas
 
 Result<ServiceConfig> parse(const std::string& text, const std::string& origin,
                             std::vector<std::string>* missing) {
+  if (auto plain = check_no_aliases(text, origin); !plain) return plain.error();
   YAML::Node root;
   try {
     root.reset(YAML::Load(text));

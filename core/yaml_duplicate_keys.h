@@ -2,15 +2,56 @@
 // yaml-cpp keeps both entries of a key written twice and a lookup answers the
 // first: a file a person edited could then mean something else than what it
 // shows. Readers of such files (recording.yaml, calibration, the ceiling
-// map) refuse it with this. Header-only: core itself does not link yaml-cpp.
+// map, the configuration) refuse it and aliases with these. Header-only:
+// core itself does not link yaml-cpp.
+#include <yaml-cpp/eventhandler.h>
 #include <yaml-cpp/yaml.h>
 
 #include <set>
+#include <sstream>
 #include <string>
 
 #include "core/result.h"
 
 namespace ceilpose {
+
+// YAML aliases (*name) are refused before a file is loaded: nothing
+// ceilpose reads needs them, and each alias of an alias multiplies what a
+// walk over the tree visits (issue 28: a 10 kB "billion laughs" map took
+// 52 s, in the daemon's control thread on a reload). The check is one pass
+// of yaml-cpp's event parser over the text; a syntax error is left for the
+// loader to report.
+inline Result<void> check_no_aliases(const std::string& text, const std::string& path) {
+  class Finder final : public YAML::EventHandler {
+   public:
+    void OnDocumentStart(const YAML::Mark&) override {}
+    void OnDocumentEnd() override {}
+    void OnNull(const YAML::Mark&, YAML::anchor_t) override {}
+    void OnAlias(const YAML::Mark& mark, YAML::anchor_t) override {
+      if (line < 0) line = mark.line;
+    }
+    void OnScalar(const YAML::Mark&, const std::string&, YAML::anchor_t,
+                  const std::string&) override {}
+    void OnSequenceStart(const YAML::Mark&, const std::string&, YAML::anchor_t,
+                         YAML::EmitterStyle::value) override {}
+    void OnSequenceEnd() override {}
+    void OnMapStart(const YAML::Mark&, const std::string&, YAML::anchor_t,
+                    YAML::EmitterStyle::value) override {}
+    void OnMapEnd() override {}
+    int line = -1;
+  } finder;
+  try {
+    std::istringstream in(text);
+    YAML::Parser parser(in);
+    while (finder.line < 0 && parser.HandleNextDocument(finder)) {
+    }
+  } catch (const YAML::Exception&) {
+    return {};  // the loader reports it, with its line
+  }
+  if (finder.line < 0) return {};
+  return make_error(path + ":" + std::to_string(finder.line + 1) +
+                    ": YAML aliases (*name) are not accepted; write the value out");
+}
 
 // The first key that appears twice in one mapping anywhere in `node`, as
 // "PATH:LINE: key 'a.b' appears twice"; success when there is none.

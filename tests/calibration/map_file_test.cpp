@@ -146,6 +146,14 @@ INSTANTIATE_TEST_SUITE_P(
                "breaks SPEC §8's datum: the best rigid fit of its 64 centres onto the nominal "
                "grid moves them by (-1000.0, "},
         BadMap{"Turned", moved_grid(0.0, 0.0, 10.0), "turns them by -10.000 deg"},
+        // Issue 28, defect 12: a 10 kB "billion laughs" map took 52 s.
+        BadMap{
+            "AliasBomb",
+            "format: ceilpose-map\nversion: 1\na: &a [x, x, x, x, x, x, x, x, x]\n"
+            "b: &b [*a, *a, *a, *a, *a, *a, *a, *a, *a]\nc: &c [*b, *b, *b, *b, *b, *b, *b, *b]\n"
+            "markers:\n" +
+                kOne,
+            ":4: YAML aliases (*name) are not accepted"},
         BadMap{"NoMarkers", "format: ceilpose-map\nversion: 1\nmarkers: []\n",
                "key 'markers' must be a non-empty list"},
         BadMap{"Empty", "", ":1: expected a YAML mapping"}),

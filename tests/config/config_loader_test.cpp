@@ -213,5 +213,13 @@ TEST(ConfigLoader, RelativeMapAndCameraFilesAreBesideTheConfiguration) {
   std::filesystem::remove_all(dir);
 }
 
+TEST(ConfigLoader, YamlAliasesAreRefusedNamingTheLine) {
+  auto config =
+      load_config_string("capture:\n  fps: &f 30\nfleet:\n  history_depth: *f\n", "x.yaml");
+  ASSERT_FALSE(config);
+  EXPECT_EQ(config.error().message,
+            "x.yaml:4: YAML aliases (*name) are not accepted; write the value out");
+}
+
 }  // namespace
 }  // namespace ceilpose
