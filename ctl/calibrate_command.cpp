@@ -32,6 +32,10 @@ constexpr int kMinViews = 10;
 // and the boards tilt at least this much, or the calibration is weak.
 constexpr double kMinCoverage = 0.75;
 constexpr double kMinTiltDeg = 15.0;
+// Progress without a terminal, and when to stop looking for a board that
+// is never found.
+constexpr size_t kProgressEveryFrames = 10;
+constexpr size_t kGiveUpFrames = 10;
 
 struct CameraArgs {
   std::string dir;
@@ -43,6 +47,7 @@ struct Views {
   std::vector<std::vector<cv::Point2f>> corners;
   std::vector<int64_t> index;  // recording frame index of each view
   size_t frames = 0;
+  bool gave_up = false;  // no board in the first kGiveUpFrames frames
 };
 
 // Finds the board in every frame: corners refined to sub-pixel.
@@ -69,9 +74,19 @@ Result<Views> find_boards(const RecordingReader& reader, const BoardSpec& board)
         gray, pattern, corners,
         cv::CALIB_CB_ADAPTIVE_THRESH | cv::CALIB_CB_NORMALIZE_IMAGE | cv::CALIB_CB_FAST_CHECK);
     ++views.frames;
+    const size_t with_board = views.corners.size() + (found ? 1 : 0);
     if (tty)
       std::fprintf(stderr, "\rcalibrate camera: frame %zu/%zu, board in %zu", i + 1,
-                   reader.rows().size(), views.corners.size() + (found ? 1 : 0));
+                   reader.rows().size(), with_board);
+    else if ((i + 1) % kProgressEveryFrames == 0)
+      std::fprintf(stderr, "calibrate camera: frame %zu/%zu, board in %zu\n", i + 1,
+                   reader.rows().size(), with_board);
+    // A board of the wrong size is searched for slowly and never found:
+    // say so early rather than after the whole recording.
+    if (with_board == 0 && views.frames == kGiveUpFrames && reader.rows().size() > kGiveUpFrames) {
+      views.gave_up = true;
+      break;
+    }
     if (!found) continue;
     cv::cornerSubPix(gray, corners, cv::Size(5, 5), cv::Size(-1, -1),
                      cv::TermCriteria(cv::TermCriteria::EPS + cv::TermCriteria::COUNT, 50, 1e-4));
@@ -182,6 +197,14 @@ void run_calibrate_camera(const CameraArgs& args) {
   if (!views) {
     std::fprintf(stderr, "ceilposectl calibrate camera: %s\n", views.error().message.c_str());
     return set_exit_code(kExitBadInput);
+  }
+  if (views->gave_up) {
+    std::fprintf(stderr,
+                 "ceilposectl calibrate camera: the %dx%d board was not found in the first %zu "
+                 "frames; stopped. Is --board right? It counts inner corners, columns first (a "
+                 "board of 10 x 7 squares is 9x6)\n",
+                 board->cols, board->rows, kGiveUpFrames);
+    return set_exit_code(kExitFailure);
   }
   const size_t found = views->corners.size();
   const size_t repeats = keep_distinct_views(&*views);

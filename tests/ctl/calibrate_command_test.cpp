@@ -206,6 +206,23 @@ TEST_F(Calibrate, CameraFromTwelveIdenticalViewsIsRefusedAndTheOldFileIsKept) {
   EXPECT_EQ(std::string(std::istreambuf_iterator<char>(in), {}), "an older calibration\n");
 }
 
+// Issue 28, defect 25: a wrong --board ran 45 s without a word.
+TEST_F(Calibrate, CameraWithTheWrongBoardStopsEarlySayingWhy) {
+  const std::string photo = std::string(kOpenCvPhotos) + "/left01.jpg";
+  ASSERT_TRUE(fs::exists(photo)) << photo << ": run scripts/setup (opencv-doc)";
+  write_photo_recording(dir_ / "rec", std::vector<std::string>(14, photo));
+  auto r = run_ceilposectl({"calibrate", "camera", "--replay", path("rec"), "--board",
+                            "checkerboard:7x5:0.025", "--out", path("camera.yaml")},
+                           kSlowMs);
+  EXPECT_EQ(r.exit_code, 1) << r.err;
+  EXPECT_NE(r.err.find("calibrate camera: frame 10/14, board in 0"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("the 7x5 board was not found in the first 10 frames; stopped. Is --board "
+                       "right?"),
+            std::string::npos)
+      << r.err;
+  EXPECT_FALSE(fs::exists(path("camera.yaml")));
+}
+
 TEST_F(Calibrate, NoCalibrationWritesOverItsOwnInput) {
   const std::string photo = std::string(kOpenCvPhotos) + "/left01.jpg";
   ASSERT_TRUE(fs::exists(photo)) << photo << ": run scripts/setup (opencv-doc)";
