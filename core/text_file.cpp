@@ -55,7 +55,11 @@ Result<void> write_all(int fd, const std::string& path, const void* data, size_t
 }  // namespace
 
 Result<void> write_file(const std::string& path, const void* data, size_t size) {
-  UniqueFd fd(::open(path.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644));
+  // O_NOFOLLOW: a symbolic link planted where an output file goes (in a
+  // directory another user can write) is not followed (issue 28 #11).
+  UniqueFd fd(::open(path.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC | O_NOFOLLOW, 0644));
+  if (!fd.valid() && errno == ELOOP)
+    return make_error(path + ": is a symbolic link: not followed; remove it or write elsewhere");
   if (!fd.valid()) return make_error(path + ": cannot create (" + std::strerror(errno) + ")");
   if (auto wrote = write_all(fd.get(), path, data, size); !wrote) return wrote;
   if (::close(fd.release()) != 0)

@@ -16,7 +16,8 @@ Result<std::string> read_text_file(const std::string& path, const char* what,
                                    size_t max_bytes = size_t{16} << 20);
 
 // Creates or truncates `path` and writes all of `data`; errors (a full disk,
-// a failing close) name the file.
+// a failing close, a symbolic link at `path`, which is not followed) name
+// the file.
 Result<void> write_file(const std::string& path, const void* data, size_t size);
 
 // Writes `text` to a temporary file beside `path`, flushes it to disk and

@@ -5,6 +5,7 @@
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
+#include "core/text_file.h"
 #include "pipeline/localization.h"
 
 namespace ceilpose::ctl {
@@ -109,15 +110,19 @@ void AnnotateSink::consume(const Localization& loc) {
   char name[64];
   std::snprintf(name, sizeof name, "/frame_%06lld.png", static_cast<long long>(loc.frame.index));
   const std::string path = dir_ + name;
-  bool ok = false;
+  // Encoded here and written by write_file, which does not follow a
+  // symbolic link planted at the name (cv::imwrite would).
   try {
-    ok = cv::imwrite(path, img);
+    if (!cv::imencode(".png", img, png_)) {
+      error_ = path + ": cannot encode the PNG";
+      return;
+    }
   } catch (const cv::Exception& ex) {
-    error_ = path + ": cannot write: " + ex.what();
+    error_ = path + ": cannot encode the PNG: " + ex.what();
     return;
   }
-  if (!ok)
-    error_ = path + ": cannot write (full disk, or the directory is missing?)";
+  if (auto wrote = write_file(path, png_.data(), png_.size()); !wrote)
+    error_ = wrote.error().message;
   else
     ++written_;
 }

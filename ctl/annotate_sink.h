@@ -5,6 +5,7 @@
 // refusal — like apriltag's debug images, one picture per frame to scroll
 // through.
 #include <string>
+#include <vector>
 
 #include "pipeline/pose_sink.h"
 
@@ -24,6 +25,7 @@ class AnnotateSink final : public PoseSink {
   bool refused_only_;
   std::string error_;
   int written_ = 0;
+  std::vector<uint8_t> png_;  // one frame's encoded picture, reused
 };
 
 }  // namespace ceilpose::ctl

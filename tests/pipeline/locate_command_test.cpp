@@ -365,6 +365,22 @@ TEST_F(LocateCommand, AnnotateWritesOnePictureOfWhatTheDetectorSawPerFrame) {
   EXPECT_EQ(lines(only.out).size(), 3u);
 }
 
+// Issue 28, defect 11: a symbolic link planted in the picture directory
+// made `locate --annotate` write wherever it pointed.
+TEST_F(LocateCommand, AnnotateDoesNotFollowALinkPlantedInItsDirectory) {
+  const fs::path rec = record({{1.2, 1.5, 0.3}});
+  const fs::path pictures = dir_ / "pictures", victim = dir_ / "victim.txt";
+  fs::create_directories(pictures);
+  std::ofstream(victim) << "precious\n";
+  fs::create_symlink(victim, pictures / "frame_000000.png");
+  const CommandRun r = run("locate --replay " + rec.string() + " --annotate " + pictures.string());
+  EXPECT_NE(r.exit_code, 0) << r.err;
+  EXPECT_NE(r.err.find("frame_000000.png: is a symbolic link: not followed"), std::string::npos)
+      << r.err;
+  std::ifstream in(victim);
+  EXPECT_EQ(std::string(std::istreambuf_iterator<char>(in), {}), "precious\n");
+}
+
 TEST_F(LocateCommand, EvaluateScoresAgainstGroundTruth) {
   const fs::path rec = record({{1.2, 1.5, 0.3}, {2.0, 2.2, -2.0}, {-20.0, -20.0, 0.0}});
   const CommandRun r = run("evaluate --json --replay " + rec.string());
