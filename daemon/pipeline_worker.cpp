@@ -26,7 +26,8 @@ PipelineWorker::PipelineWorker(const ServiceConfig& config, WorkerOptions option
       sinks_(sinks.begin(), sinks.end()),
       progress_(progress),
       localizer_(config.pipeline),
-      next_status_ns_(sinks.size(), 0) {}
+      next_status_ns_(sinks.size(), 0),
+      fix_lost_after_ns_(int64_t{config.ipc.stale_after_ms} * 1'000'000) {}
 
 PipelineWorker::~PipelineWorker() { stop(); }
 
@@ -103,6 +104,7 @@ void PipelineWorker::process(const capture::Frame& frame) {
   for (PublishingSink* sink : sinks_) sink->consume(loc);
 
   stamps.published_ns = monotonic_ns();
+  last_frame_mono_ns_ = stamps.published_ns;
   if (frames_.load(std::memory_order_relaxed) >= options_.latency_warmup_frames)
     latency_.record(stamps);
 
@@ -147,7 +149,14 @@ void PipelineWorker::publish_status(int64_t now_ns, bool all) {
   status.latency = latency_.capture_to_published().summary();
   status.source_failed = capture_->failed();
   status.source = capture_->description().c_str();
+  // The fix of the last frame, unless no frame has come for longer than a
+  // pose counts as fresh (ipc.stale_after_ms, what `ceilposectl pose`
+  // judges by): then it is lost, not "fix" (issue 28 #22: a replay's 1 h
+  // gap left status saying "fix" while pose said stale).
   status.fix = last_.fix;
+  if ((status.fix == FixState::kOk || status.fix == FixState::kCoasting) &&
+      now_ns - last_frame_mono_ns_ > fix_lost_after_ns_)
+    status.fix = FixState::kLost;
   status.mode = last_.mode;
   status.markers = last_.markers;
   status.refusals = localizer_.refusals().snapshot();

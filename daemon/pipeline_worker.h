@@ -106,6 +106,8 @@ class PipelineWorker {
   int64_t fps_ns_ = 0;
   double fps_ = 0.0;
   PoseSnapshot last_;
+  int64_t last_frame_mono_ns_ = 0;  // when the last frame's pose was published
+  const int64_t fix_lost_after_ns_;
 
   capture::FrameLatency latency_;
   std::atomic<uint64_t> frames_{0};

@@ -10,6 +10,8 @@
 #include <sstream>
 
 #include "core/exit_codes.h"
+#include "core/fix_state.h"
+#include "ipc/shm/shm_pose_reader.h"
 #include "ipc/shm/shm_pose_writer.h"
 #include "recording/recording_writer.h"
 #include "sim/renderer.h"
@@ -21,8 +23,9 @@ namespace {
 
 // A 320x240 recording of the simulator's trajectory, with ground truth, by
 // default under SPEC's ceiling and lens heights.
+// Frames from `gap_after` on come an hour later (SPEC §4 allows any gap).
 std::string write_small_recording(int frames, double ceiling_height_m = 2.4384,
-                                  double lens_height_m = 0.3048) {
+                                  double lens_height_m = 0.3048, int gap_after = -1) {
   const std::string dir = testing::TempDir() + "ceilposed-replay-" + std::to_string(getpid());
   std::filesystem::remove_all(dir);
   sim::SceneOptions scene;
@@ -40,7 +43,8 @@ std::string write_small_recording(int frames, double ceiling_height_m = 2.4384,
   for (int i = 0; i < frames; ++i) {
     const Pose2D truth = sim::trajectory_pose(scene.layout, i / 30.0);
     renderer.render(truth, mount, sim::Effects{}, static_cast<uint64_t>(i), &frame);
-    auto r = writer->append(frame.view(), 1'000'000'000 + i * 33'333'333LL, &truth);
+    const int64_t gap_ns = gap_after >= 0 && i >= gap_after ? 3'600'000'000'000LL : 0;
+    auto r = writer->append(frame.view(), 1'000'000'000 + i * 33'333'333LL + gap_ns, &truth);
     EXPECT_TRUE(r.ok()) << r.error().message;
   }
   EXPECT_TRUE(writer->close().ok());
@@ -68,6 +72,24 @@ TEST(DaemonReplay, LocalizesWithTheRecordingsCameraNotTheConfiguredOne) {
     EXPECT_LT(std::strtod(line.c_str() + at + 5, nullptr), 10.0) << line;
   }
   EXPECT_GT(checked, 3) << r.out;
+}
+
+// Issue 28, defect 22: a replay's 1 h gap left `status` saying "fix" for as
+// long as no frame came, while `pose` said stale.
+TEST(DaemonReplay, NoFrameForLongerThanStaleAfterMsIsALostFix) {
+  const std::string dir = write_small_recording(20, 2.4384, 0.3048, 10);
+  const std::string shm = unique_shm_name();
+  auto r = run_daemon({"--source", "replay:" + dir, "--shm", shm, "--no-dds", "--duration", "2.5"});
+  std::filesystem::remove_all(dir);
+  ASSERT_EQ(r.exit.code, ceilpose::kExitOk) << r.err;
+  auto reader = ShmPoseReader::open(shm);
+  ASSERT_TRUE(reader) << reader.error().message;
+  StatusRecord status{};
+  ASSERT_EQ(reader->read_status(&status), ReadResult::kOk);
+  (void)ShmPoseWriter::remove(shm);
+  EXPECT_EQ(status.frames, 10u);
+  EXPECT_EQ(static_cast<FixState>(status.fix_state), FixState::kLost)
+      << to_string(static_cast<FixState>(status.fix_state));
 }
 
 TEST(DaemonReplay, HeightsTheMarkersContradictGiveNoPoseAndAReasonInTheLog) {
