@@ -11,6 +11,7 @@
 #include <random>
 #include <vector>
 
+#include "core/camera_model.h"
 #include "core/pose.h"
 
 namespace ceilpose {
@@ -25,7 +26,15 @@ constexpr double kForwardM = 0.115, kLeftM = -0.042, kYawRad = 2.5 * kDeg;
 // (0.2 mm, 0.02°, as localization gives under a surveyed ceiling).
 class Drive {
  public:
-  explicit Drive(double fps = 10.0, uint32_t seed = 1) : dt_s_(1.0 / fps), rng_(seed) {}
+  explicit Drive(double fps = 10.0, uint32_t seed = 1) : dt_s_(1.0 / fps), rng_(seed) {
+    mount_.offset_forward_m = kForwardM;
+    mount_.offset_left_m = kLeftM;
+    mount_.yaw_rad = kYawRad;
+  }
+  Drive& mounted(const CameraMount& mount) {
+    mount_ = mount;
+    return *this;
+  }
   Drive& straight(double v_mps, double duration_s) { return arc(v_mps, 0.0, duration_s); }
   Drive& turn(double w_radps, double duration_s) { return arc(0.0, w_radps, duration_s); }
   Drive& pause(double duration_s) { return arc(0.0, 0.0, duration_s); }
@@ -72,12 +81,14 @@ class Drive {
   void see() {
     std::normal_distribution<double> pos(0.0, 0.0002), ang(0.0, 0.02 * kDeg);
     const double c = std::cos(robot_.yaw_rad), s = std::sin(robot_.yaw_rad);
-    samples_.push_back({t_s_, robot_.x_m + c * kForwardM - s * kLeftM + pos(rng_),
-                        robot_.y_m + s * kForwardM + c * kLeftM + pos(rng_),
-                        wrap_angle_rad(robot_.yaw_rad + kYawRad + ang(rng_))});
+    samples_.push_back(
+        {t_s_, robot_.x_m + c * mount_.offset_forward_m - s * mount_.offset_left_m + pos(rng_),
+         robot_.y_m + s * mount_.offset_forward_m + c * mount_.offset_left_m + pos(rng_),
+         wrap_angle_rad(robot_.yaw_rad + mount_.yaw_rad + ang(rng_))});
   }
   double dt_s_;
   std::mt19937 rng_;
+  CameraMount mount_;
   Pose2D robot_{1.0, 1.0, 0.3};
   double t_s_ = 0.0;
   double drift_x_mps_ = 0.0;
@@ -116,6 +127,30 @@ TEST(MountEstimate, AnOrdinaryDriveWithArcsUsesOnlyTheTurnsInPlace) {
   for (const MotionSegment& g : m->segments) arcs += g.kind == MotionSegment::kArc ? 1 : 0;
   EXPECT_EQ(arcs, 2);
   EXPECT_EQ(m->backwards_m, 0.0);
+}
+
+// Other mounts: issue 27's second robot, a camera at the turning centre, one
+// far out and turned 10°, one behind and turned the other way.
+TEST(MountEstimate, OtherMountsAreFoundAsWell) {
+  for (const CameraMount& truth : {CameraMount{0.3048, -0.085, 0.030, -3.0 * kDeg, 0.0, 0.0},
+                                   CameraMount{0.3048, 0.0, 0.0, 0.0, 0.0, 0.0},
+                                   CameraMount{0.3048, 0.25, 0.10, 10.0 * kDeg, 0.0, 0.0},
+                                   CameraMount{0.3048, -0.20, -0.15, -7.0 * kDeg, 0.0, 0.0}}) {
+    Drive d;
+    d.mounted(truth);
+    d.straight(0.25, 3.0)
+        .arc(0.25, 0.4, 3.0)
+        .turn(0.9, 5.0)
+        .straight(0.25, 2.0)
+        .arc(0.2, -0.5, 4.0)
+        .turn(-0.8, 4.0)
+        .straight(0.3, 2.0);
+    auto m = estimate_mount(d.samples());
+    ASSERT_TRUE(m) << truth.offset_forward_m << ": " << m.error().message;
+    EXPECT_NEAR(m->offset_forward_m, truth.offset_forward_m, 0.001) << truth.offset_forward_m;
+    EXPECT_NEAR(m->offset_left_m, truth.offset_left_m, 0.001) << truth.offset_forward_m;
+    EXPECT_NEAR(m->yaw_rad, truth.yaw_rad, 0.05 * kDeg) << truth.offset_forward_m;
+  }
 }
 
 TEST(MountEstimate, ThirtyFramesASecondGiveTheSame) {
