@@ -410,7 +410,7 @@ void run_calibrate_mount(MountArgs& args) {
   }
   print_mount_report(*m, track.samples);
   std::fprintf(stderr,
-               "calibrate mount: camera %.1f +- %.1f mm forward, %.1f +- %.1f mm left of the "
+               "calibrate mount: camera %.2f +- %.2f mm forward, %.2f +- %.2f mm left of the "
                "robot origin, turned %.3f +- %.3f deg\n",
                1000.0 * m->offset_forward_m, 1000.0 * m->sigma_forward_m, 1000.0 * m->offset_left_m,
                1000.0 * m->sigma_left_m, m->yaw_rad * kDeg, m->sigma_yaw_rad * kDeg);

@@ -187,7 +187,7 @@ void run_calibrate_robot(const RobotArgs& args) {
     std::fprintf(stderr, "  principal point cx %.2f +- %.2f, cy %.2f +- %.2f px\n", k.cx,
                  r.sigma_intrinsics[4], k.cy, r.sigma_intrinsics[5]);
   std::fprintf(stderr,
-               "  mount: camera %.1f +- %.1f mm forward, %.1f +- %.1f mm left of the robot "
+               "  mount: camera %.2f +- %.2f mm forward, %.2f +- %.2f mm left of the robot "
                "origin, turned %.3f +- %.3f deg (%d turns in place, %.0f deg; %d straight runs, "
                "%.2f m)\n",
                1000.0 * mount->offset_forward_m, 1000.0 * mount->sigma_forward_m,

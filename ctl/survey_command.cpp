@@ -155,8 +155,8 @@ void run_survey(const SurveyArgs& args) {
   auto mount = estimate_mount(track);
   if (mount) {
     std::fprintf(stderr,
-                 "survey: the walk's turns in place give the mount: camera %.1f +- %.1f mm "
-                 "forward, %.1f +- %.1f mm left of the robot origin, turned %.3f +- %.3f deg\n",
+                 "survey: the walk's turns in place give the mount: camera %.2f +- %.2f mm "
+                 "forward, %.2f +- %.2f mm left of the robot origin, turned %.3f +- %.3f deg\n",
                  1000.0 * mount->offset_forward_m, 1000.0 * mount->sigma_forward_m,
                  1000.0 * mount->offset_left_m, 1000.0 * mount->sigma_left_m, kDeg * mount->yaw_rad,
                  kDeg * mount->sigma_yaw_rad);
