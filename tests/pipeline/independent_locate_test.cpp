@@ -388,7 +388,8 @@ TEST(IndependentLocateGrey, GreyscalePngRecordingGivesNoPoseOnAnyFrame) {
     const LocateOutput run = run_locate(recording, fs::path(), scratch.path());
     ASSERT_EQ(run.exit_code, 0) << run.stderr_text;
     // Said once, and on every frame (issue 27: not "no_markers").
-    EXPECT_NE(run.stderr_text.find("12 of 12 frames are greyscale"), std::string::npos)
+    const std::string n = std::to_string(truth.size());  // fewer under the sanitizers
+    EXPECT_NE(run.stderr_text.find(n + " of " + n + " frames are greyscale"), std::string::npos)
         << c.name << ": " << run.stderr_text;
     ASSERT_EQ(run.lines.size(), truth.size()) << run.stderr_text;
     for (const std::string& line : run.lines) {
