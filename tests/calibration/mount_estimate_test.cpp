@@ -8,6 +8,7 @@
 
 #include <cmath>
 #include <numbers>
+#include <optional>
 #include <random>
 #include <vector>
 
@@ -105,8 +106,9 @@ void expect_right(const Result<MountEstimate>& m) {
 }
 
 // A commissioning drive: straight runs, arcs and two turns in place.
-Drive ordinary_drive(double fps = 10.0) {
+Drive ordinary_drive(double fps = 10.0, std::optional<CameraMount> mount = std::nullopt) {
   Drive d(fps);
+  if (mount) d.mounted(*mount);
   d.straight(0.25, 3.0)
       .arc(0.25, 0.4, 3.0)
       .turn(0.9, 5.0)
@@ -136,16 +138,7 @@ TEST(MountEstimate, OtherMountsAreFoundAsWell) {
                                    CameraMount{0.3048, 0.0, 0.0, 0.0, 0.0, 0.0},
                                    CameraMount{0.3048, 0.25, 0.10, 10.0 * kDeg, 0.0, 0.0},
                                    CameraMount{0.3048, -0.20, -0.15, -7.0 * kDeg, 0.0, 0.0}}) {
-    Drive d;
-    d.mounted(truth);
-    d.straight(0.25, 3.0)
-        .arc(0.25, 0.4, 3.0)
-        .turn(0.9, 5.0)
-        .straight(0.25, 2.0)
-        .arc(0.2, -0.5, 4.0)
-        .turn(-0.8, 4.0)
-        .straight(0.3, 2.0);
-    auto m = estimate_mount(d.samples());
+    auto m = estimate_mount(ordinary_drive(10.0, truth).samples());
     ASSERT_TRUE(m) << truth.offset_forward_m << ": " << m.error().message;
     EXPECT_NEAR(m->offset_forward_m, truth.offset_forward_m, 0.001) << truth.offset_forward_m;
     EXPECT_NEAR(m->offset_left_m, truth.offset_left_m, 0.001) << truth.offset_forward_m;
