@@ -213,6 +213,7 @@ void describe(V& v, ServiceConfig& c) {
     v.field("gate_min_m", f.gate_min_m, 0.0, 100.0);
     v.field("gate_min_rad", f.gate_min_rad, 0.0, kPi);
     v.field("reinit_after_gated", f.reinit_after_gated, 1, 100000);
+    v.field("min_frame_interval_ms", f.min_frame_interval_ms, 0.0, 1000.0);
     v.field("predict_timeout_ms", f.predict_timeout_ms, 0.0, 60000.0);
     v.field("init_velocity_sigma_mps", f.init_velocity_sigma_mps, 1e-6, 100.0);
     v.field("init_yaw_rate_sigma_radps", f.init_yaw_rate_sigma_radps, 1e-6, 100.0);

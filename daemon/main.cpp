@@ -9,6 +9,7 @@
 
 #include "core/exit_codes.h"
 #include "core/resource_limits.h"
+#include "daemon/cyclone_log.h"
 #include "daemon/daemon_options.h"
 #include "daemon/logging.h"
 #include "daemon/service.h"
@@ -67,6 +68,7 @@ int main(int argc, char** argv) {
   }
 
   setup_logging(detect_log_target(), config->logging.level);
+  route_cyclone_log();
   // Measured: with DDS on, 16 descriptors and 390 MiB of address space run;
   // 12 and 290 MiB crash inside Cyclone DDS. The needs leave a margin.
   if (const std::string limit = resource_limit_problem({32, 512}); !limit.empty()) {

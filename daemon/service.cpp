@@ -21,6 +21,7 @@
 #include "capture/source_spec.h"
 #include "core/clock.h"
 #include "core/exit_codes.h"
+#include "daemon/cyclone_log.h"
 #include "daemon/dds_pose_sink.h"
 #include "daemon/fleet_thread.h"
 #include "daemon/logging.h"
@@ -398,6 +399,7 @@ void Service::loop() {
       for (const PublishingSink* sink : sinks_) failures += sink->failures();
       problems_.report(worker_->refusals().snapshot(), failures,
                        static_cast<double>(problem_period_ns) * 1e-9);
+      report_dropped_cyclone_lines();
     }
     if (options_.print_poses && now >= next_print) {
       next_print = now + kPrintPeriodNs;

@@ -2,6 +2,8 @@
 // The keystore of a secure fleet (SPEC §11): `ceilposectl keys init|add`
 // make it, ceilposed and `ceilposectl fleet` check an enclave of it before
 // they create a DDS participant. Layout: keystore/keystore_layout.h.
+#include <sys/types.h>
+
 #include <ctime>
 #include <string>
 
@@ -35,7 +37,16 @@ struct EnclaveRequest {
 // pose and status.
 Result<void> add_enclave(const std::string& dir, const EnclaveRequest& request);
 
-// The enclave's six files once each is there and good at `now`: certificates
+// What ssh checks of a private key, applied to an enclave as `user` would
+// use it: the keystore, enclaves and enclave directories and the six files
+// belong to `user` or root and no group or other user may write them; the
+// private key is readable by nobody else (mode 0600 or less), or, owned by
+// root, by its group at most (0640: root:ceilpose for a service user).
+// Errors name the path, its mode in octal and its owner.
+Result<void> check_enclave_protection(const std::string& dir, const std::string& name, uid_t user);
+
+// The enclave's six files once each is there and good at `now`, protected
+// as check_enclave_protection says for this process's effective user: certificates
 // parse and are in date, the certificate was issued by the identity CA, the
 // key is the certificate's, governance and permissions verify against the
 // permissions CA, and the permissions grant the certificate's subject at

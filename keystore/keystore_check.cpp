@@ -2,6 +2,9 @@
 // participant exists: the plugins only say "not allowed" into Cyclone's trace,
 // and by then a daemon may be half started.
 #include <sys/stat.h>
+#include <unistd.h>
+
+#include <cstdio>
 
 #include "core/text_file.h"
 #include "keystore/keystore.h"
@@ -43,7 +46,49 @@ Result<void> issued_by(X509* cert, const std::string& cert_path, X509* ca,
                     "): the enclave comes from another keystore, or its CA was replaced");
 }
 
+std::string octal(unsigned mode) {
+  char text[8];
+  std::snprintf(text, sizeof text, "%04o", mode & 07777u);
+  return text;
+}
+
+// `path` belongs to `user` or root and no one else may write it; `private_key`
+// adds who may read it.
+Result<void> protected_path(const std::string& path, uid_t user, bool private_key) {
+  struct stat st {};
+  if (::stat(path.c_str(), &st) != 0) return {};  // a missing file is named by its reader
+  const std::string what =
+      path + " (mode " + octal(st.st_mode) + ", owner uid " + std::to_string(st.st_uid) + ")";
+  if (st.st_uid != user && st.st_uid != 0) {
+    return make_error(what + " belongs to another user (this process runs as uid " +
+                      std::to_string(user) + "): whoever owns it can replace the robot's identity");
+  }
+  if ((st.st_mode & 022u) != 0) {
+    return make_error(what + " is writable by its group or by others: anyone could replace " +
+                      "the robot's identity; chmod go-w it");
+  }
+  if (!private_key) return {};
+  const unsigned too_open = st.st_uid == 0 && user != 0 ? 037u : 077u;
+  if ((st.st_mode & too_open) != 0) {
+    return make_error(what + ": the private key is readable by others; chmod " +
+                      (too_open == 037u ? "0640" : "0600") + " it (an unprotected key lets " +
+                      "anyone on this computer speak as the robot)");
+  }
+  return {};
+}
+
 }  // namespace
+
+Result<void> check_enclave_protection(const std::string& dir, const std::string& name, uid_t user) {
+  const KeystoreLayout ks{dir};
+  const DdsSecurityFiles files = ks.enclave_files(name);
+  for (const std::string& path :
+       {dir, dir + "/enclaves", ks.enclave_dir(name), files.identity_ca, files.certificate,
+        files.permissions_ca, files.governance, files.permissions}) {
+    if (auto ok = protected_path(path, user, false); !ok) return ok;
+  }
+  return protected_path(files.private_key, user, true);
+}
 
 Result<DdsSecurityFiles> check_enclave(const std::string& dir, const std::string& name,
                                        std::time_t now) {
@@ -55,6 +100,7 @@ Result<DdsSecurityFiles> check_enclave(const std::string& dir, const std::string
                       dir + " --robot " + name + "'");
   }
   const DdsSecurityFiles files = ks.enclave_files(name);
+  if (auto ok = check_enclave_protection(dir, name, ::geteuid()); !ok) return ok.error();
   auto identity_ca = read_certificate(files.identity_ca);
   if (!identity_ca) return identity_ca.error();
   auto permissions_ca = read_certificate(files.permissions_ca);

@@ -161,9 +161,14 @@ PoseEstimate TemporalFilter::update(const PoseEstimate& m, int64_t frame_ns) {
     initialised_ = false;
     ++stats_.timeouts;
   }
-  if (!initialised_) {
+  const bool too_close =
+      initialised_ && m.valid &&
+      static_cast<double>(frame_ns - last_frame_ns_) < params_.min_frame_interval_ms * 1e6;
+  if (!initialised_ || too_close) {
     if (!m.valid) return PoseEstimate{};
+    if (too_close) ++stats_.close_restarts;
     initialise(m, timestamp_ns);
+    last_frame_ns_ = frame_ns;
     ++stats_.updates;
     return output(&m, frame_ns);
   }
@@ -182,6 +187,7 @@ PoseEstimate TemporalFilter::update(const PoseEstimate& m, int64_t frame_ns) {
       // enough: the robot was moved or the filter diverged.
       ++stats_.reinitialisations;
       initialise(m, timestamp_ns);
+      last_frame_ns_ = frame_ns;
       return output(&m, frame_ns);
     }
     ++stats_.predictions;
@@ -190,6 +196,7 @@ PoseEstimate TemporalFilter::update(const PoseEstimate& m, int64_t frame_ns) {
   correct(y, s_inv);
   consecutive_gated_ = 0;
   last_measurement_ns_ = timestamp_ns;
+  last_frame_ns_ = frame_ns;
   last_mode_ = m.mode;
   ++stats_.updates;
   return output(&m, frame_ns);

@@ -19,6 +19,7 @@ struct FilterStats {
   uint64_t reinitialisations = 0;  // re-starts after reinit_after_gated gated in a row
   uint64_t predictions = 0;        // outputs predicted without a measurement
   uint64_t timeouts = 0;           // times the filter gave up after predict_timeout_ms
+  uint64_t close_restarts = 0;     // re-starts on a frame within min_frame_interval_ms
 };
 
 // Not thread-safe: one instance, called from the pipeline thread in frame
@@ -32,7 +33,9 @@ class TemporalFilter {
   // (timestamp_ns + its time_offset_s), and returns the filtered pose at
   // timestamp_ns; invalid until a first valid measurement and again once
   // predict_timeout_ms passes without one. An instant earlier than the
-  // previous one is treated as the same instant.
+  // previous one is treated as the same instant. A valid measurement of a
+  // frame stamped within min_frame_interval_ms of the last one fused (or
+  // earlier) restarts the filter on itself.
   PoseEstimate update(const PoseEstimate& measurement, int64_t timestamp_ns);
   void reset();
 
@@ -63,6 +66,7 @@ class TemporalFilter {
   MotionState state_;
   int64_t last_ns_ = 0;              // time the state refers to
   int64_t last_measurement_ns_ = 0;  // last fused (or initialising) measurement
+  int64_t last_frame_ns_ = 0;        // the frame stamp of that measurement
   int consecutive_gated_ = 0;
   PositioningMode last_mode_ = PositioningMode::kAuto;
 };

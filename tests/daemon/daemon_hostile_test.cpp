@@ -1,16 +1,21 @@
 // Issue 15: ceilposed in a hostile or broken environment. Each test
 // reproduces a probe that once hung, killed or fooled the daemon, and
 // asserts the precise message and exit code it gives now.
+#include <arpa/inet.h>
 #include <fcntl.h>
 #include <gtest/gtest.h>
+#include <netinet/in.h>
+#include <sys/socket.h>
 #include <unistd.h>
 
+#include <random>
 #include <string>
 #include <vector>
 
 #include "core/exit_codes.h"
 #include "ipc/shm/shm_pose_writer.h"
 #include "tests/daemon/daemon_process.h"
+#include "tests/ipc/dds/dds_test_env.h"
 
 namespace ceilpose::test {
 namespace {
@@ -114,6 +119,60 @@ TEST_F(DaemonHostile, ANameTakenInDevShmExitsFiveNamingWhatHoldsIt) {
   unlink(squat.c_str());
   EXPECT_EQ(r.exit.code, ceilpose::kExitShmNameTaken) << r.err;
   EXPECT_NE(r.err.find(squat + " is a symbolic link owned by uid"), std::string::npos) << r.err;
+}
+
+// `count` datagrams with an RTPS header and random submessages to every
+// port a participant of `domain` listens on (RTPS 9.6.1.1: 7400 + 250 d,
+// unicast + 10 + 2 i, i = 0, 1).
+void send_rtps_garbage(uint32_t domain, int count) {
+  const int fd = ::socket(AF_INET, SOCK_DGRAM, 0);
+  ASSERT_GE(fd, 0);
+  std::mt19937 rng(1);
+  const int base = 7400 + 250 * static_cast<int>(domain);
+  for (int i = 0; i < count; ++i) {
+    unsigned char packet[100] = {'R', 'T', 'P', 'S', 2, 1, 1, 15};
+    const size_t size = 28 + rng() % 72;
+    for (size_t b = 20; b < size; ++b) packet[b] = static_cast<unsigned char>(rng());
+    for (int port : {base, base + 1, base + 10, base + 11, base + 12, base + 13}) {
+      sockaddr_in to{};
+      to.sin_family = AF_INET;
+      to.sin_port = htons(static_cast<uint16_t>(port));
+      to.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+      (void)::sendto(fd, packet, size, 0, reinterpret_cast<sockaddr*>(&to), sizeof to);
+    }
+  }
+  ::close(fd);
+}
+
+// Issue 28 #24: malformed RTPS datagrams made Cyclone DDS write 19,094 lines
+// (7.4 MB) to stderr in 6 s, past the daemon's non-blocking writer. Now its
+// lines go through the daemon's log, 20 at once then one a second, and the
+// dropped ones are counted.
+TEST_F(DaemonHostile, NetworkGarbageCannotFloodTheLog) {
+  use_loopback_dds();
+  const uint32_t domain = unique_domain_id();
+  const std::string config =
+      write_temp_file("problems.yaml", "logging:\n  problem_report_interval_ms: 1000\n");
+  DaemonProcess daemon(
+      {"--config", config, "--source", "synthetic", "--shm", shm_, "--domain",
+       std::to_string(domain), "--robot", unique_robot_name("garbage"), "--duration", "6"},
+      {});
+  ASSERT_NE(daemon.read_error_until("ceilposed running", 10000).find("ceilposed running"),
+            std::string::npos)
+      << daemon.err();
+  send_rtps_garbage(domain, 4000);
+  const auto exit = daemon.wait(kBoundMs);
+  ASSERT_TRUE(exit.has_value()) << daemon.err();
+  EXPECT_EQ(exit->code, kExitOk) << daemon.err();
+  const std::string& err = daemon.err();
+  size_t dds_lines = 0;
+  for (size_t at = err.find("dds: "); at != std::string::npos; at = err.find("dds: ", at + 1))
+    ++dds_lines;
+  EXPECT_GE(dds_lines, 2u) << "Cyclone's warnings should still be seen: " << err;
+  EXPECT_LE(dds_lines, 20u + 8u) << err.substr(0, 4000);
+  EXPECT_LT(err.size(), 32'000u);
+  EXPECT_NE(err.find("messages of Cyclone DDS dropped (rate limit 1 a second)"), std::string::npos)
+      << err.substr(0, 4000);
 }
 
 }  // namespace

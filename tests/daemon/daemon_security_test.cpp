@@ -4,6 +4,7 @@
 // camera or publishes anything, naming the file, with exit 6.
 #include <gtest/gtest.h>
 #include <signal.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include <ctime>
@@ -202,6 +203,14 @@ TEST_F(DaemonSecurity, ACertificateOfAnotherCaStopsTheDaemon) {
                ks.files("r1").identity_ca),
       std::string::npos)
       << err;
+}
+
+TEST_F(DaemonSecurity, AWorldReadableKeyStopsTheDaemonNamingItsMode) {
+  TestKeystore ks{"r1"};
+  const std::string key = ks.files("r1").private_key;
+  ASSERT_EQ(::chmod(key.c_str(), 0644), 0);
+  const std::string err = refused(ks.dir());
+  EXPECT_NE(err.find(key + " (mode 0644"), std::string::npos) << err;
 }
 
 TEST_F(DaemonSecurity, AMissingFileOrEnclaveStopsTheDaemonNamingIt) {

@@ -6,6 +6,7 @@
 
 #include <sstream>
 
+#include "daemon/cyclone_log.h"
 #include "daemon/problem_report.h"
 
 namespace ceilpose::daemon {
@@ -62,6 +63,28 @@ TEST(ProblemReport, ReportsOnlyWhatGrewSinceTheLastReport) {
   EXPECT_EQ(report.update(counts_with({{Refusal::kNoMarkers, 1}}), 0), "") << "nothing new";
   EXPECT_EQ(report.update(counts_with({{Refusal::kNoMarkers, 1}, {Refusal::kWrongHeights, 3}}), 0),
             "3 " + std::string(describe(Refusal::kWrongHeights)));
+}
+
+TEST(LogRateLimit, AdmitsABurstThenOneLineASecondAndCountsTheRest) {
+  LogRateLimit limit(20, 1.0);
+  uint64_t dropped = 99;
+  for (int i = 0; i < 20; ++i) ASSERT_TRUE(limit.admit(1'000, &dropped)) << i;
+  EXPECT_EQ(dropped, 0u);
+  for (int i = 0; i < 500; ++i) EXPECT_FALSE(limit.admit(1'000 + i, &dropped));
+  EXPECT_FALSE(limit.admit(500'000'000, &dropped));  // half a second later: no token yet
+  ASSERT_TRUE(limit.admit(1'000'001'000, &dropped));
+  EXPECT_EQ(dropped, 501u);
+  EXPECT_FALSE(limit.admit(1'000'002'000, &dropped));
+  EXPECT_EQ(limit.take_dropped(), 1u);
+  EXPECT_EQ(limit.take_dropped(), 0u);
+}
+
+TEST(LogRateLimit, AClockThatStepsBackDoesNotMintTokens) {
+  LogRateLimit limit(1, 1.0);
+  uint64_t dropped = 0;
+  ASSERT_TRUE(limit.admit(10'000'000'000, &dropped));
+  EXPECT_FALSE(limit.admit(1'000, &dropped));
+  EXPECT_FALSE(limit.admit(10'000'000'000, &dropped));
 }
 
 }  // namespace

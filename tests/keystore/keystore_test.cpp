@@ -2,6 +2,7 @@
 
 #include <gtest/gtest.h>
 #include <sys/stat.h>
+#include <unistd.h>
 
 #include <cstdio>
 #include <ctime>
@@ -184,6 +185,56 @@ TEST_F(KeystoreTest, AMissingEnclaveOrFileIsNamed) {
   EXPECT_NE(check_error("r1", now_).find(r1().permissions_ca + ": cannot read certificate"),
             std::string::npos)
       << check_error("r1", now_);
+}
+
+// As ssh treats ~/.ssh: a key others can read, or a directory others can
+// write, is refused with its path and mode before any participant exists.
+TEST_F(KeystoreTest, AWorldReadablePrivateKeyIsRefusedWithItsMode) {
+  ASSERT_EQ(::chmod(r1().private_key.c_str(), 0644), 0);
+  const std::string error = check_error("r1", now_);
+  EXPECT_NE(error.find(r1().private_key + " (mode 0644"), std::string::npos) << error;
+  EXPECT_NE(error.find("readable by others; chmod 0600"), std::string::npos) << error;
+}
+
+TEST_F(KeystoreTest, AWorldWritableKeystoreDirectoryIsRefusedWithItsMode) {
+  for (const std::string& path : {dir() + "/enclaves", layout().enclave_dir("r1"), dir()}) {
+    ASSERT_EQ(::chmod(path.c_str(), 0777), 0);
+    const std::string error = check_error("r1", now_);
+    EXPECT_NE(error.find(path + " (mode 0777"), std::string::npos) << error;
+    EXPECT_NE(error.find("writable by its group or by others"), std::string::npos) << error;
+    ASSERT_EQ(::chmod(path.c_str(), 0755), 0);
+  }
+  EXPECT_EQ(check_error("r1", now_), "(no error)");
+}
+
+TEST_F(KeystoreTest, AnEnclaveOwnedByAnotherUserIsRefused) {
+  const std::string enclave = layout().enclave_dir("r1");
+  std::string error;
+  if (::geteuid() == 0) {  // root may give the enclave away for real
+    ASSERT_EQ(::chown(enclave.c_str(), 4242, 4242), 0);
+    error = check_error("r1", now_);
+  } else {  // otherwise the check runs as if this were another user's process
+    auto ok = check_enclave_protection(dir(), "r1", ::geteuid() + 1);
+    error = ok ? std::string("(no error)") : ok.error().message;
+  }
+  EXPECT_NE(error.find("belongs to another user"), std::string::npos) << error;
+}
+
+// A service user reads a root-owned key through its group (root:ceilpose
+// 0640), as PostgreSQL allows; others may not read it even then.
+TEST_F(KeystoreTest, ARootOwnedKeyMayBeReadByItsGroupOnly) {
+  ASSERT_EQ(::chmod(r1().private_key.c_str(), 0640), 0);
+  const uid_t service_user = 4242;
+  if (::geteuid() == 0) {
+    EXPECT_TRUE(check_enclave_protection(dir(), "r1", service_user));
+    ASSERT_EQ(::chmod(r1().private_key.c_str(), 0644), 0);
+    auto ok = check_enclave_protection(dir(), "r1", service_user);
+    ASSERT_FALSE(ok);
+    EXPECT_NE(ok.error().message.find("chmod 0640"), std::string::npos) << ok.error().message;
+  } else {  // its owner, not root, may not share it with its group
+    const std::string error = check_error("r1", now_);
+    EXPECT_NE(error.find(r1().private_key + " (mode 0640"), std::string::npos) << error;
+  }
 }
 
 TEST_F(KeystoreTest, ATamperedPermissionsDocumentFailsItsSignature) {

@@ -193,5 +193,37 @@ TEST(TemporalFilter, CovarianceShrinksAsMeasurementsAccumulate) {
   EXPECT_LT(out.covariance[0], first.covariance[0]);
 }
 
+// SPEC §4 allows equal stamps. A robot driving 1 m/s whose frames all carry
+// one stamp (or stamps 1 ns apart) moves 33 mm between frames the filter
+// cannot tell apart in time: each pose must stay within 3 of its own
+// reported sd of the truth, never a smoothed pose far behind.
+void expect_honest_on_stamps(int64_t stamp_step_ns) {
+  TemporalFilter filter{FilterParams{}};
+  std::mt19937_64 rng(11);
+  std::normal_distribution<double> noise(0.0, 0.0005);
+  for (int k = 0; k < 60; ++k) {
+    const double truth_x_m = 1.0 + 1.0 * k * 0.0333;
+    const PoseEstimate out = filter.update(
+        measurement(truth_x_m + noise(rng), 1.0 + noise(rng), 0.0, 0.0005), k * stamp_step_ns);
+    ASSERT_TRUE(out.valid) << "frame " << k;
+    const double sd_m = std::sqrt(out.covariance[0]);
+    EXPECT_LT(std::abs(out.pose.x_m - truth_x_m), 3.0 * sd_m + 1e-4) << "frame " << k;
+    EXPECT_LT(sd_m, 0.001) << "frame " << k;
+  }
+  EXPECT_EQ(filter.stats().close_restarts, 59u);
+  EXPECT_EQ(filter.stats().gated, 0u);
+}
+
+TEST(TemporalFilter, FramesWithEqualStampsRestartOnTheirOwnPose) { expect_honest_on_stamps(0); }
+
+TEST(TemporalFilter, FramesOneNanosecondApartRestartOnTheirOwnPose) { expect_honest_on_stamps(1); }
+
+TEST(TemporalFilter, FramesAMillisecondApartAreFused) {
+  TemporalFilter filter{FilterParams{}};
+  for (int k = 0; k < 10; ++k) filter.update(measurement(1.0, 1.0, 0.0), k * 1'000'000);
+  EXPECT_EQ(filter.stats().close_restarts, 0u);
+  EXPECT_EQ(filter.stats().updates, 10u);
+}
+
 }  // namespace
 }  // namespace ceilpose
