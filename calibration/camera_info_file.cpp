@@ -60,7 +60,8 @@ std::string numbers(const double* v, int n) {
 }  // namespace
 
 Result<CameraIntrinsics> read_camera_info_file(const std::string& path) {
-  auto root = load_yaml_mapping(path, "camera calibration (camera_info YAML)");
+  constexpr size_t kMaxCameraInfoNodes = 1000;  // a camera_info file has about 60
+  auto root = load_yaml_mapping(path, "camera calibration (camera_info YAML)", kMaxCameraInfoNodes);
   if (!root) return root.error();
   CameraIntrinsics k;
   for (auto [key, dst] :

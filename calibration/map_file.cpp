@@ -152,7 +152,10 @@ Result<CeilingMap> read_map_file(const std::string& path, const CeilingLayout& l
 }
 
 static Result<CeilingMap> read_map(const std::string& path, const CeilingLayout& layout) {
-  auto root = load_yaml_mapping(path, "ceiling map");
+  // A marker is 17 entries (its mapping, six keys with values, the code's
+  // list of two); a map holds each code once.
+  const size_t codes = static_cast<size_t>(layout.codes());
+  auto root = load_yaml_mapping(path, "ceiling map", 20 * codes * codes + 64);
   if (!root) return root.error();
   if (auto known = only_keys(path, *root, {"format", "version", "ceiling", "markers"}, "");
       !known) {

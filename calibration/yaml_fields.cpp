@@ -13,10 +13,10 @@ std::string where(const std::string& path, const YAML::Node& node) {
   return path + ":" + std::to_string(node.Mark().line + 1);
 }
 
-Result<YAML::Node> load_yaml_mapping(const std::string& path, const char* what) {
+Result<YAML::Node> load_yaml_mapping(const std::string& path, const char* what, size_t max_nodes) {
   auto text = read_text_file(path, what, size_t{64} << 20);
   if (!text) return text.error();
-  if (auto plain = check_no_aliases(*text, path); !plain) return plain.error();
+  if (auto plain = check_plain_yaml(*text, path, max_nodes); !plain) return plain.error();
   YAML::Node root;
   try {
     root = YAML::Load(*text);

@@ -11,9 +11,10 @@
 
 namespace ceilpose::calibration_detail {
 
-// The file's root mapping; a missing file, a directory, bad syntax or a
-// root that is not a mapping is an error.
-Result<YAML::Node> load_yaml_mapping(const std::string& path, const char* what);
+// The file's root mapping; a missing file, a directory, bad syntax, more
+// than `max_nodes` YAML entries (check_plain_yaml) or a root that is not a
+// mapping is an error.
+Result<YAML::Node> load_yaml_mapping(const std::string& path, const char* what, size_t max_nodes);
 
 // "FILE:LINE" of a node.
 std::string where(const std::string& path, const YAML::Node& node);

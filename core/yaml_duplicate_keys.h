@@ -15,37 +15,65 @@
 
 namespace ceilpose {
 
-// YAML aliases (*name) are refused before a file is loaded: nothing
-// ceilpose reads needs them, and each alias of an alias multiplies what a
-// walk over the tree visits (issue 28: a 10 kB "billion laughs" map took
-// 52 s, in the daemon's control thread on a reload). The check is one pass
-// of yaml-cpp's event parser over the text; a syntax error is left for the
-// loader to report.
-inline Result<void> check_no_aliases(const std::string& text, const std::string& path) {
+// One pass of yaml-cpp's event parser over the text before it is loaded,
+// refusing what would make loading it cost more than its size says:
+// - aliases (*name): nothing ceilpose reads needs them, and each alias of an
+//   alias multiplies what a walk over the tree visits (issue 28: a 10 kB
+//   "billion laughs" map took 52 s, in the daemon's control thread on a
+//   reload);
+// - more than `max_nodes` nodes (scalars, lists, mappings): a tree costs
+//   ~70 bytes of memory per byte of text (issue 28: an 11 MB map needed
+//   780 MB, and a reload under a memory limit killed the daemon), so each
+//   reader bounds its file by the entries it can hold, not only its bytes.
+// A syntax error is left for the loader to report, with its line.
+inline Result<void> check_plain_yaml(const std::string& text, const std::string& path,
+                                     size_t max_nodes) {
+  struct TooManyNodes {
+    YAML::Mark mark;
+  };
   class Finder final : public YAML::EventHandler {
    public:
+    explicit Finder(size_t max_nodes) : max_nodes_(max_nodes) {}
     void OnDocumentStart(const YAML::Mark&) override {}
     void OnDocumentEnd() override {}
-    void OnNull(const YAML::Mark&, YAML::anchor_t) override {}
+    void OnNull(const YAML::Mark& mark, YAML::anchor_t) override { count(mark); }
     void OnAlias(const YAML::Mark& mark, YAML::anchor_t) override {
       if (line < 0) line = mark.line;
     }
-    void OnScalar(const YAML::Mark&, const std::string&, YAML::anchor_t,
-                  const std::string&) override {}
-    void OnSequenceStart(const YAML::Mark&, const std::string&, YAML::anchor_t,
-                         YAML::EmitterStyle::value) override {}
+    void OnScalar(const YAML::Mark& mark, const std::string&, YAML::anchor_t,
+                  const std::string&) override {
+      count(mark);
+    }
+    void OnSequenceStart(const YAML::Mark& mark, const std::string&, YAML::anchor_t,
+                         YAML::EmitterStyle::value) override {
+      count(mark);
+    }
     void OnSequenceEnd() override {}
-    void OnMapStart(const YAML::Mark&, const std::string&, YAML::anchor_t,
-                    YAML::EmitterStyle::value) override {}
+    void OnMapStart(const YAML::Mark& mark, const std::string&, YAML::anchor_t,
+                    YAML::EmitterStyle::value) override {
+      count(mark);
+    }
     void OnMapEnd() override {}
     int line = -1;
-  } finder;
+
+   private:
+    void count(const YAML::Mark& mark) {
+      if (++nodes_ > max_nodes_) throw TooManyNodes{mark};
+    }
+    size_t max_nodes_;
+    size_t nodes_ = 0;
+  } finder(max_nodes);
   try {
     // The first document only, as YAML::Load reads; looping over documents
     // never ended on some inputs (found by fuzz_map and its siblings).
     std::istringstream in(text);
     YAML::Parser parser(in);
     parser.HandleNextDocument(finder);
+  } catch (const TooManyNodes& e) {
+    return make_error(path + ":" + std::to_string(e.mark.line + 1) + ": more than " +
+                      std::to_string(max_nodes) +
+                      " YAML entries (values, lists, mappings), more than a file of this kind "
+                      "can hold; is it the right file?");
   } catch (const YAML::Exception&) {
     return {};  // the loader reports it, with its line
   }

@@ -12,6 +12,7 @@
 #include <cstring>
 #include <ctime>
 #include <memory>
+#include <new>
 #include <numbers>
 #include <sstream>
 #include <string>
@@ -449,7 +450,17 @@ void Service::reload() {
     notifier_.reloaded();
     return;
   }
-  auto next = resolve_config(options_);
+  // A reload may fail in any way and the daemon goes on as it ran: out of
+  // memory too (a huge map under LimitAS=), which used to end it.
+  Result<ServiceConfig> next = make_error("not read");
+  try {
+    next = resolve_config(options_);
+  } catch (const std::bad_alloc&) {
+    next =
+        make_error(options_.config_path +
+                   " or a file it names needs more memory than the daemon may use "
+                   "(LimitAS=, ulimit -v); is a map or camera file far larger than it should be?");
+  }
   if (!next) {
     spdlog::error("SIGHUP: keeping the running configuration: {}", next.error().message);
     notifier_.reloaded();

@@ -1,6 +1,7 @@
 #include "calibration/map_file.h"
 
 #include <gtest/gtest.h>
+#include <sys/resource.h>
 #include <unistd.h>
 
 #include <cmath>
@@ -154,10 +155,38 @@ INSTANTIATE_TEST_SUITE_P(
             "markers:\n" +
                 kOne,
             ":4: YAML aliases (*name) are not accepted"},
+        // Issue 28, defect 13: the entries a 3-bit ceiling's map can hold.
+        BadMap{"MoreEntriesThanAnyMap",
+               std::string(kHeader) +
+                   [] {
+                     std::string many;
+                     for (int k = 0; k < 200; ++k) many += kOne;
+                     return many;
+                   }(),
+               ": more than 1344 YAML entries (values, lists, mappings), more than a file of "
+               "this kind can hold"},
         BadMap{"NoMarkers", "format: ceilpose-map\nversion: 1\nmarkers: []\n",
                "key 'markers' must be a non-empty list"},
         BadMap{"Empty", "", ":1: expected a YAML mapping"}),
     [](const auto& info) { return std::string(info.param.name); });
+
+// Issue 28, defect 13: an 11 MB map needed ~780 MB to parse, and a reload
+// under a memory limit ended the daemon. Refused now by its entry count, in
+// one streaming pass.
+TEST(MapFile, AnElevenMegabyteMapIsRefusedWithoutLoadingIt) {
+  std::string text = kHeader;
+  while (text.size() < (size_t{11} << 20)) text += kOne;
+  const std::string path = write_temp("huge.yaml", text);
+  rusage before{};
+  ::getrusage(RUSAGE_SELF, &before);
+  auto map = read_map_file(path, CeilingLayout{});
+  rusage after{};
+  ::getrusage(RUSAGE_SELF, &after);
+  ASSERT_FALSE(map);
+  EXPECT_NE(map.error().message.find("more than 1344 YAML entries"), std::string::npos)
+      << map.error().message;
+  EXPECT_LT(after.ru_maxrss - before.ru_maxrss, 200 * 1024) << "peak RSS grew (KiB)";
+}
 
 TEST(MapFile, ADirectoryOrAMissingFileIsAnError) {
   auto dir = read_map_file(::testing::TempDir(), CeilingLayout{});
