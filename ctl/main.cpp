@@ -5,6 +5,7 @@
 #include <cstdio>
 #include <cstring>
 #include <iostream>
+#include <new>
 
 #include "config/cli_checks.h"
 #include "ctl/command_registry.h"
@@ -40,6 +41,10 @@ int main(int argc, char** argv) {
   } catch (const CLI::ParseError& e) {
     const int rc = app.exit(e);
     return rc == 0 ? kExitOk : kExitUsage;
+  } catch (const std::bad_alloc&) {
+    std::cerr << "ceilposectl: out of memory: the address-space limit (ulimit -v) or the "
+                 "machine's memory is too small for this work\n";
+    return kExitFailure;
   } catch (const std::exception& e) {
     std::cerr << "ceilposectl: " << e.what() << "\n";
     return kExitFailure;

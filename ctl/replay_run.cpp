@@ -132,6 +132,14 @@ int run_replay(const ReplayArgs& args, const char* command, const ReplaySetup& s
   const RecordingReader& reader = *setup.reader;
   Localizer localizer(setup.config);
   FramePrefetcher frames(reader, args.decode_threads);
+  if (frames.threads() < args.decode_threads) {
+    const CameraIntrinsics& k = reader.camera().intrinsics;
+    std::fprintf(stderr,
+                 "ceilposectl %s: decoding on %d threads, not %d: %dx%d frames on more would "
+                 "hold over %zu MiB\n",
+                 command, frames.threads(), args.decode_threads, k.width, k.height,
+                 FramePrefetcher::kDecodeBudgetBytes >> 20);
+  }
   const size_t total = reader.rows().size();
   HeightsCheck heights(total);
   const bool tty = ::isatty(STDERR_FILENO) == 1;

@@ -1,7 +1,9 @@
 #include "recording/frame_prefetcher.h"
 
 #include <algorithm>
+#include <stdexcept>
 #include <string>
+#include <system_error>
 
 namespace ceilpose {
 
@@ -16,12 +18,20 @@ int FramePrefetcher::default_threads() {
   return std::clamp(static_cast<int>(cpus), 1, kMaxThreads);
 }
 
+int FramePrefetcher::threads_within_budget(int requested, size_t frame_bytes) {
+  const size_t frames = kDecodeBudgetBytes / std::max<size_t>(frame_bytes, 1);
+  const size_t fit = frames > 2 ? (frames - 2) / 2 : 0;
+  return std::clamp(static_cast<int>(std::min<size_t>(fit, 1024)), 1, std::max(requested, 1));
+}
+
 FramePrefetcher::FramePrefetcher(const RecordingReader& reader, int threads, size_t first)
     : reader_(reader),
       end_(reader.rows().size()),
       next_claim_(std::min(first, reader.rows().size())),
       next_out_(next_claim_) {
-  threads = std::max(threads, 1);
+  const CameraIntrinsics& k = reader.camera().intrinsics;
+  threads = threads_within_budget(threads, static_cast<size_t>(std::max(k.width, 0)) *
+                                               static_cast<size_t>(std::max(k.height, 0)) * 3);
   // One slot per worker to decode into, one the consumer holds, one spare so
   // that a worker never waits for the consumer to finish a frame.
   slots_.resize(static_cast<size_t>(threads) + 2);
@@ -29,7 +39,17 @@ FramePrefetcher::FramePrefetcher(const RecordingReader& reader, int threads, siz
   workers_.reserve(static_cast<size_t>(threads));
   for (int t = 0; t < threads; ++t) {
     buffers_.push_back(RecordingReader::make_decode_buffers());
-    workers_.emplace_back(&FramePrefetcher::worker, this, buffers_.back().get());
+    // A thread's stack may not fit under an address-space limit: decode on
+    // the threads that started (unwinding past running threads would end
+    // the program in std::terminate).
+    try {
+      workers_.emplace_back(&FramePrefetcher::worker, this, buffers_.back().get());
+    } catch (const std::system_error& e) {
+      buffers_.pop_back();
+      if (workers_.empty())
+        throw std::runtime_error(std::string("cannot start a frame-decoding thread: ") + e.what());
+      break;
+    }
   }
 }
 

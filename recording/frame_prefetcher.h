@@ -23,8 +23,17 @@ namespace ceilpose {
 class FramePrefetcher {
  public:
   // Starts `threads` decoding threads (at least 1) over the reader's frames
-  // from `first`. The reader must outlive the prefetcher.
+  // from `first`, fewer when their frames would not fit kDecodeBudgetBytes.
+  // The reader must outlive the prefetcher.
   FramePrefetcher(const RecordingReader& reader, int threads, size_t first = 0);
+
+  // What the frames held in decoding may take (issue 28: 32-Mpx frames on 16
+  // threads took 4 GB and ended in std::bad_alloc): each thread holds its
+  // frame twice (decoded BGR, and RGB in its slot) and two more slots wait.
+  static constexpr size_t kDecodeBudgetBytes = size_t{1} << 30;
+  // The threads `requested` frames of `frame_bytes` (RGB) may have.
+  static int threads_within_budget(int requested, size_t frame_bytes);
+  int threads() const { return static_cast<int>(workers_.size()); }
   ~FramePrefetcher();  // stops the workers and joins them; never waits for a decode to be consumed
   FramePrefetcher(const FramePrefetcher&) = delete;
   FramePrefetcher& operator=(const FramePrefetcher&) = delete;

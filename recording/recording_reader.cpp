@@ -11,6 +11,8 @@
 #include <cstdio>
 #include <cstring>
 #include <fstream>
+#include <memory>
+#include <new>
 #include <opencv2/core.hpp>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
@@ -518,13 +520,48 @@ Result<void> RecordingReader::load_frame(size_t i, Image* out) const {
   return load_frame(i, out, scratch_.get());
 }
 
+namespace {
+
+// Why a frame could not be decoded when memory ran out: OpenCV catches its
+// own allocation failures and only says the data is corrupt (issue 28), so
+// a failed decode tries to allocate what it needed before blaming the file.
+std::string out_of_memory_text(const FrameFileInfo& info) {
+  const size_t bytes = static_cast<size_t>(info.width) * static_cast<size_t>(info.height) * 3;
+  return "not enough memory to decode this " + std::to_string(info.width) + "x" +
+         std::to_string(info.height) + " frame (" + std::to_string(bytes >> 20) +
+         " MiB decoded, twice that while decoding): raise the address-space limit (ulimit -v, "
+         "LimitAS=) or decode on fewer threads (--decode-threads)";
+}
+
+bool memory_for(const FrameFileInfo& info) {
+  const size_t bytes = static_cast<size_t>(info.width) * static_cast<size_t>(info.height) * 3;
+  std::unique_ptr<uint8_t[]> probe(new (std::nothrow) uint8_t[2 * bytes]);
+  return probe != nullptr;
+}
+
+}  // namespace
+
 Result<void> RecordingReader::load_frame(size_t i, Image* out, DecodeBuffers* buffers) const {
+  try {
+    return decode_frame(i, out, buffers);
+  } catch (const std::bad_alloc&) {
+    return make_error(frame_context(i) + ": " + out_of_memory_text(buffers->info));
+  }
+}
+
+Result<void> RecordingReader::decode_frame(size_t i, Image* out, DecodeBuffers* buffers) const {
   auto read = read_frame_file(i, buffers);
   if (!read) return read;
   const auto& bytes = buffers->file_bytes;
   const FrameFileInfo& info = buffers->info;
   const cv::Mat encoded(1, static_cast<int>(bytes.size()), CV_8UC1,
                         const_cast<uint8_t*>(bytes.data()));
+  const auto decode_failed = [&] {
+    return make_error(frame_context(i) + ": " +
+                      (memory_for(info) ? std::string("corrupt ") + to_string(info.encoding) +
+                                              " data (decoder failed)"
+                                        : out_of_memory_text(info)));
+  };
   // Grey frames decode straight into `out`; colour frames go through the
   // reused BGR buffer because OpenCV decodes to BGR and we hand out RGB.
   try {
@@ -534,22 +571,22 @@ Result<void> RecordingReader::load_frame(size_t i, Image* out, DecodeBuffers* bu
       cv::imdecode(encoded, cv::IMREAD_UNCHANGED, &dst);
       if (dst.data != out->data() || dst.type() != CV_8UC1 || dst.cols != info.width ||
           dst.rows != info.height) {
-        return make_error(frame_context(i) + ": corrupt " + to_string(info.encoding) +
-                          " data (decoder failed)");
+        return decode_failed();
       }
     } else {
       cv::Mat& bgr = buffers->decoded;
       const cv::Mat result = cv::imdecode(encoded, cv::IMREAD_UNCHANGED, &bgr);
       if (result.empty() || bgr.type() != CV_8UC3 || bgr.cols != info.width ||
           bgr.rows != info.height) {
-        return make_error(frame_context(i) + ": corrupt " + to_string(info.encoding) +
-                          " data (decoder failed)");
+        return decode_failed();
       }
       out->resize(info.width, info.height, PixelFormat::kRgb24);
       cv::Mat dst(info.height, info.width, CV_8UC3, out->data());
       cv::cvtColor(bgr, dst, cv::COLOR_BGR2RGB);
     }
   } catch (const cv::Exception& e) {
+    if (e.code == cv::Error::StsNoMem || !memory_for(info))
+      return make_error(frame_context(i) + ": " + out_of_memory_text(info));
     return make_error(frame_context(i) + ": corrupt " + to_string(info.encoding) + " data (" +
                       e.what() + ")");
   }

@@ -81,6 +81,7 @@ class RecordingReader {
  private:
   RecordingReader();
   Result<void> read_frame_file(size_t i, DecodeBuffers* buffers) const;
+  Result<void> decode_frame(size_t i, Image* out, DecodeBuffers* buffers) const;
 
   std::string dir_;
   RecordingCamera camera_;

@@ -12,6 +12,7 @@
 #include <string>
 #include <vector>
 
+#include "core/exit_codes.h"
 #include "recording/recording_writer.h"
 #include "sim/renderer.h"
 
@@ -40,10 +41,11 @@ class LocateCommand : public ::testing::Test {
     if (!dir_.empty()) fs::remove_all(dir_);
   }
 
-  CommandRun run(const std::string& args) {
+  // `shell_prefix`: shell commands run first, e.g. "ulimit -v 700000; ".
+  CommandRun run(const std::string& args, const std::string& shell_prefix = "") {
     const fs::path out = dir_ / "stdout.txt", err = dir_ / "stderr.txt";
-    const std::string cmd = ctl_binary().string() + " " + args + " >" + out.string() + " 2>" +
-                            err.string() + " </dev/null";
+    const std::string cmd = shell_prefix + "exec " + ctl_binary().string() + " " + args + " >" +
+                            out.string() + " 2>" + err.string() + " </dev/null";
     const int status = std::system(cmd.c_str());
     CommandRun r;
     r.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
@@ -379,6 +381,54 @@ TEST_F(LocateCommand, AnnotateDoesNotFollowALinkPlantedInItsDirectory) {
       << r.err;
   std::ifstream in(victim);
   EXPECT_EQ(std::string(std::istreambuf_iterator<char>(in), {}), "precious\n");
+}
+
+// Issue 28, defect 14: 32-Mpx frames under a memory limit ended `locate` in
+// an uncaught std::bad_alloc (SIGABRT) on a decoding thread, or, at a lower
+// limit, were called "corrupt PNG data". Decoding now takes at most
+// FramePrefetcher::kDecodeBudgetBytes whatever --decode-threads says, and
+// running out of memory is named as such.
+TEST_F(LocateCommand, ThirtyTwoMegapixelFramesUnderAMemoryLimitNameTheCause) {
+#if defined(__SANITIZE_ADDRESS__) || defined(__SANITIZE_THREAD__)
+  GTEST_SKIP() << "sanitizers reserve terabytes of address space: no ulimit -v can be set";
+#endif
+  const fs::path rec = dir_ / "big";
+  CameraIntrinsics k = sim::SceneOptions{}.intrinsics;
+  k.width = 6000;
+  k.height = 5400;
+  k.cx = 2999.5;
+  k.cy = 2699.5;
+  auto writer = RecordingWriter::create(rec.string(), RecordingCamera{k, "32 Mpx"});
+  ASSERT_TRUE(writer.ok()) << writer.error().message;
+  Image image;
+  image.resize(k.width, k.height, PixelFormat::kRgb24);
+  for (int f = 0; f < 3; ++f)
+    ASSERT_TRUE(writer->append(image.view(), 1'000'000'000 + 33'333'333 * int64_t(f), nullptr));
+  ASSERT_TRUE(writer->close().ok());
+
+  const CommandRun many = run("locate --replay " + rec.string() + " --decode-threads 16");
+  EXPECT_EQ(many.exit_code, 0) << many.err;
+  EXPECT_NE(many.err.find("decoding on 4 threads, not 16: 6000x5400 frames on more would hold "
+                          "over 1024 MiB"),
+            std::string::npos)
+      << many.err;
+  EXPECT_EQ(lines(many.out).size(), 3u);
+
+  bool named = false;
+  for (int limit_mib : {400, 600, 800, 1000, 1200}) {
+    const CommandRun r = run("locate --replay " + rec.string() + " --decode-threads 16",
+                             "ulimit -v " + std::to_string(limit_mib * 1024) + "; ");
+    SCOPED_TRACE("ulimit -v " + std::to_string(limit_mib) + " MiB");
+    ASSERT_NE(r.exit_code, -1) << "ended by a signal: " << r.err;
+    EXPECT_EQ(r.err.find("corrupt"), std::string::npos) << r.err;
+
+    if (r.exit_code == 0) continue;
+    EXPECT_TRUE(r.exit_code == kExitBadInput || r.exit_code == kExitFailure) << r.err;
+    EXPECT_NE(r.err.find("memory"), std::string::npos) << r.err;
+    named = named ||
+            r.err.find("not enough memory to decode this 6000x5400 frame") != std::string::npos;
+  }
+  EXPECT_TRUE(named) << "no limit tried failed in decoding";
 }
 
 TEST_F(LocateCommand, EvaluateScoresAgainstGroundTruth) {

@@ -126,5 +126,16 @@ TEST(FramePrefetcher, DefaultThreadsIsBetweenOneAndFour) {
 INSTANTIATE_TEST_SUITE_P(Threads, FramePrefetcherTest, ::testing::Values(1, 2, 4),
                          [](const auto& info) { return std::to_string(info.param) + "_threads"; });
 
+// Issue 28, defect 14: each thread holds two frames; 16 threads of 32-Mpx
+// frames took 4 GB. The budget, not the request, bounds them.
+TEST(FramePrefetcherBudget, ThreadsHoldAtMostTheDecodeBudget) {
+  const size_t vga = 640 * 480 * 3, mpx32 = size_t{6000} * 5400 * 3;
+  EXPECT_EQ(FramePrefetcher::threads_within_budget(16, vga), 16);
+  EXPECT_EQ(FramePrefetcher::threads_within_budget(16, mpx32), 4);
+  EXPECT_LE((2 * 4 + 2) * mpx32, FramePrefetcher::kDecodeBudgetBytes);
+  EXPECT_EQ(FramePrefetcher::threads_within_budget(64, FramePrefetcher::kDecodeBudgetBytes), 1);
+  EXPECT_EQ(FramePrefetcher::threads_within_budget(0, 0), 1);
+}
+
 }  // namespace
 }  // namespace ceilpose
