@@ -19,6 +19,7 @@ PoseRecord pose_record_of(const Localization& loc, int64_t real_minus_mono_ns) {
   rec.markers = static_cast<uint16_t>(out.markers);
   rec.refusal = static_cast<uint8_t>(out.refusal);
   set_pose_motion(&rec, loc.motion);
+  make_publishable(&rec);
   return rec;
 }
 

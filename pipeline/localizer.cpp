@@ -6,6 +6,24 @@
 #include "core/clock.h"
 
 namespace ceilpose {
+namespace {
+
+bool all_finite(const double* v, size_t n) {
+  return std::all_of(v, v + n, [](double x) { return std::isfinite(x); });
+}
+
+bool finite_estimate(const PoseEstimate& e) {
+  const double pose[] = {e.pose.x_m, e.pose.y_m, e.pose.yaw_rad, e.rms_residual_px,
+                         e.time_offset_s};
+  return all_finite(pose, std::size(pose)) && all_finite(e.covariance.data(), e.covariance.size());
+}
+
+bool finite_motion(const MotionEstimate& m) {
+  return !m.valid || (all_finite(m.state.x.data(), m.state.x.size()) &&
+                      all_finite(m.state.p.data(), m.state.p.size()));
+}
+
+}  // namespace
 
 PipelineConfig with_mode(PipelineConfig config, PositioningMode mode, bool filter) {
   config.positioning.mode = mode;
@@ -40,6 +58,13 @@ const Localization& Localizer::localize(const ImageView& image, const FrameInfo&
   out_.markers = std::span<const MarkerObservation>(result_->markers.data(),
                                                     static_cast<size_t>(result_->marker_count));
   out_.stage_ns = result_->stage_ns;
+  // Nothing non-finite leaves the localizer, so no output (JSON, shared
+  // memory, DDS) can carry it (issue 28: a map sigma of 1e154 gave valid
+  // poses with a NaN covariance). Defence in depth: the inputs are bounded.
+  if (out_.measured.valid && !finite_estimate(out_.measured)) {
+    out_.measured.valid = false;
+    out_.measured.refusal = Refusal::kSolverRejected;
+  }
 
   // 2. Over time (the frame's own time, so processing jitter does not enter).
   out_.filtered = filter;
@@ -49,6 +74,13 @@ const Localization& Localizer::localize(const ImageView& image, const FrameInfo&
   }
   out_.refusal = out_.measured.valid ? out_.published.refusal : out_.measured.refusal;
   out_.motion = filter && out_.published.valid ? filter_.motion() : MotionEstimate{};
+  if (out_.published.valid && (!finite_estimate(out_.published) || !finite_motion(out_.motion))) {
+    filter_.reset();  // a state that is not finite never becomes finite again
+    out_.published = PoseEstimate{};
+    out_.published.refusal = Refusal::kFilterRejected;
+    out_.motion = MotionEstimate{};
+    if (out_.measured.valid) out_.refusal = Refusal::kFilterRejected;
+  }
 
   // 3. Fix state.
   if (out_.measured.valid && out_.published.valid) {

@@ -14,22 +14,10 @@ constexpr int64_t kMsNs = 1'000'000;
 // Distinct (robot, reason) pairs reported before the keeper stops naming them.
 constexpr size_t kMaxReported = 1024;
 
-bool all_finite(const double* v, size_t n) {
-  return std::all_of(v, v + n, [](double x) { return std::isfinite(x); });
-}
-
 // A pose a controller could act on: valid, every number finite, variances
 // not negative. What arrives over the network is checked like a file.
 bool plausible(const PoseRecord& p) {
-  if (!pose_is_valid(p)) return false;
-  const double scalars[] = {p.x_m,     p.y_m,     p.yaw_rad,
-                            p.vx_mps,  p.vy_mps,  p.yaw_rate_radps,
-                            p.ax_mps2, p.ay_mps2, p.yaw_accel_radps2};
-  if (!all_finite(scalars, std::size(scalars)) || !all_finite(p.covariance, 9) ||
-      !all_finite(p.state_covariance, std::size(p.state_covariance)) ||
-      !all_finite(p.jerk_density, 3)) {
-    return false;
-  }
+  if (!pose_is_valid(p) || !pose_numbers_finite(p)) return false;
   for (int i = 0; i < 3; ++i)
     if (p.covariance[i * 4] < 0.0) return false;
   return true;

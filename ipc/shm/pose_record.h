@@ -48,6 +48,13 @@ const char* pose_mode_name(uint8_t mode);
 
 inline bool pose_is_valid(const PoseRecord& p) { return (p.flags & kPoseValid) != 0; }
 
+// Every number of the record (pose, covariance, motion, jerk) is finite.
+bool pose_numbers_finite(const PoseRecord& p);
+// The record as an output may carry it: unchanged when its numbers are
+// finite, otherwise invalid with every number 0 (issue 28: nothing
+// non-finite reaches shared memory or DDS).
+void make_publishable(PoseRecord* p);
+
 // The filter's motion into the record's motion fields and CEILPOSE_POSE_MOTION
 // (cleared, and the fields zeroed, when `motion` is not valid).
 void set_pose_motion(PoseRecord* pose, const MotionEstimate& motion);

@@ -26,7 +26,9 @@ double degrees(double rad) { return rad * 180.0 / std::numbers::pi; }
 }  // namespace
 
 std::string pose_json(const PoseRecord& p, int64_t now_mono_ns, const std::string& extra) {
-  const bool valid = pose_is_valid(p);
+  // A record some other writer filled with NaN is shown as no pose: JSON has
+  // no NaN, and a controller must not act on it.
+  const bool valid = pose_is_valid(p) && pose_numbers_finite(p);
   std::string out = format("{\"seq\":%" PRIu64 ",\"valid\":%s", p.seq, valid ? "true" : "false");
   const Pose2D pose{p.x_m, p.y_m, p.yaw_rad};
   out += pose_fields_json(valid ? &pose : nullptr);

@@ -8,10 +8,13 @@
 #include <unistd.h>
 
 #include <chrono>
+#include <cmath>
+#include <limits>
 #include <thread>
 
 #include "capture/capture_thread.h"
 #include "capture/frame_source.h"
+#include "daemon/pose_record_of.h"
 #include "daemon/shm_pose_sink.h"
 #include "ipc/shm/shm_pose_reader.h"
 #include "ipc/shm/shm_pose_writer.h"
@@ -221,6 +224,30 @@ TEST(PipelineWorker, TheFrameLoopAllocatesNothing) {
   ASSERT_TRUE(wait_frames(worker, kWindowFirst + kWindowFrames + 1));
   worker.stop();
   EXPECT_EQ(window.allocations, 0) << "over " << kWindowFrames << " frames";
+}
+
+// Issue 28, defect 4: shared memory and DDS both carry what pose_record_of
+// makes; a pose with a non-finite number leaves it as no pose, all zeros.
+TEST(PoseRecordOf, ANonFinitePoseLeavesAsNoPoseWithFiniteNumbers) {
+  Localization loc;
+  loc.published.valid = true;
+  loc.published.pose = {1.0, 2.0, 0.3};
+  loc.published.covariance = {1e-6, 0, 0, 0, 1e-6, 0, 0, 0, 1e-6};
+  PoseRecord good = pose_record_of(loc, 0);
+  EXPECT_TRUE(pose_is_valid(good));
+  EXPECT_DOUBLE_EQ(good.x_m, 1.0);
+
+  loc.published.covariance[4] = std::nan("");
+  PoseRecord bad = pose_record_of(loc, 0);
+  EXPECT_FALSE(pose_is_valid(bad));
+  EXPECT_TRUE(pose_numbers_finite(bad));
+
+  loc.published.covariance[4] = 1e-6;
+  loc.motion.valid = true;
+  loc.motion.state.p[40] = std::numeric_limits<double>::infinity();
+  bad = pose_record_of(loc, 0);
+  EXPECT_FALSE(pose_is_valid(bad));
+  EXPECT_TRUE(pose_numbers_finite(bad));
 }
 
 }  // namespace

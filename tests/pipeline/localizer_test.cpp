@@ -94,6 +94,23 @@ TEST_F(LocalizerTest, FilteredCoastsThroughAMissingFrameThenLosesTheFix) {
   EXPECT_EQ(localizer.refusals()[Refusal::kNone], 1u);
 }
 
+// Issue 28, defect 4: a filter whose numbers overflow (here an initial
+// velocity sd of 1e200 m/s, whose variance is infinite) publishes no pose,
+// named, rather than a pose with an infinite covariance; and it starts again.
+TEST_F(LocalizerTest, ANonFiniteFilterStateIsNeverPublished) {
+  config_.filter.init_velocity_sigma_mps = 1e200;
+  Localizer localizer(with_mode(config_, PositioningMode::kAuto, true));
+  const Image ceiling = frame_at({1.5, 2.5, -1.0});
+  for (int k = 0; k < 3; ++k) {
+    const Localization& loc = localizer.localize(ceiling.view(), next_frame());
+    EXPECT_TRUE(loc.measured.valid);
+    EXPECT_FALSE(loc.published.valid) << "frame " << k;
+    EXPECT_EQ(loc.published.refusal, Refusal::kFilterRejected);
+    EXPECT_EQ(loc.refusal, Refusal::kFilterRejected);
+    EXPECT_FALSE(loc.motion.valid);
+  }
+}
+
 TEST_F(LocalizerTest, WrongHeightsAreRefusedWhereThePositionerDecides) {
   // The configuration's lens sits 0.4 m lower than the camera that rendered
   // the frame: the markers' spacing says so.
