@@ -1,6 +1,7 @@
 #include "recording/frame_prefetcher.h"
 
 #include <algorithm>
+#include <new>
 #include <stdexcept>
 #include <string>
 #include <system_error>
@@ -78,9 +79,19 @@ void FramePrefetcher::worker(RecordingReader::DecodeBuffers* buffers) {
     slot.ready = false;
     slot.frame = frame;
     lock.unlock();
-    Result<void> status = reader_.load_frame(frame, &slot.image, buffers);
+    Result<void> status;
+    bool out_of_memory = false;
+    try {
+      status = reader_.load_frame(frame, &slot.image, buffers);
+    } catch (const std::bad_alloc&) {
+      // Not even the error fitted: free this frame and let the consumer's
+      // thread say it (an exception leaving a thread ends the program).
+      slot.image = Image{};
+      out_of_memory = true;
+    }
     lock.lock();
     slot.status = std::move(status);
+    slot.out_of_memory = out_of_memory;
     slot.ready = true;
     frame_ready_.notify_all();
   }
@@ -100,6 +111,7 @@ Result<const Image*> FramePrefetcher::next() {
   frame_ready_.wait(lock, [&] { return slot.ready && slot.frame == next_out_; });
   ++next_out_;
   holding_ = true;
+  if (slot.out_of_memory) return make_error(reader_.out_of_memory_error(slot.frame));
   if (!slot.status) return slot.status.error();
   return &slot.image;
 }

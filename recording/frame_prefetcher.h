@@ -50,6 +50,7 @@ class FramePrefetcher {
   struct Slot {
     Image image;
     Result<void> status;
+    bool out_of_memory = false;  // its error is made by next(), not the worker
     size_t frame = 0;
     bool ready = false;
   };

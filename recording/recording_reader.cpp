@@ -387,7 +387,20 @@ RecordingReader::RecordingReader(RecordingReader&&) noexcept = default;
 RecordingReader& RecordingReader::operator=(RecordingReader&&) noexcept = default;
 RecordingReader::~RecordingReader() = default;
 
+// OpenCV builds its table of decoders on the first encode or decode, and on
+// Debian that registers every GDAL driver, which calls abort() when memory
+// runs out (issue 28: 32-Mpx frames on several threads under ulimit -v).
+// Built here, once, while memory is plentiful.
+static void prepare_image_codecs() {
+  static const bool ready = [] {
+    std::vector<uchar> png;
+    return cv::imencode(".png", cv::Mat(1, 1, CV_8UC1, cv::Scalar(0)), png);
+  }();
+  (void)ready;
+}
+
 Result<RecordingReader> RecordingReader::open(const std::string& dir) {
+  prepare_image_codecs();
   struct stat st {};
   if (::stat(dir.c_str(), &st) != 0) {
     return make_error(dir + ": recording directory does not exist (" + std::strerror(errno) + ")");
@@ -525,10 +538,10 @@ namespace {
 // Why a frame could not be decoded when memory ran out: OpenCV catches its
 // own allocation failures and only says the data is corrupt (issue 28), so
 // a failed decode tries to allocate what it needed before blaming the file.
-std::string out_of_memory_text(const FrameFileInfo& info) {
-  const size_t bytes = static_cast<size_t>(info.width) * static_cast<size_t>(info.height) * 3;
-  return "not enough memory to decode this " + std::to_string(info.width) + "x" +
-         std::to_string(info.height) + " frame (" + std::to_string(bytes >> 20) +
+std::string out_of_memory_text(int width, int height) {
+  const size_t bytes = static_cast<size_t>(width) * static_cast<size_t>(height) * 3;
+  return "not enough memory to decode this " + std::to_string(width) + "x" +
+         std::to_string(height) + " frame (" + std::to_string(bytes >> 20) +
          " MiB decoded, twice that while decoding): raise the address-space limit (ulimit -v, "
          "LimitAS=) or decode on fewer threads (--decode-threads)";
 }
@@ -545,8 +558,15 @@ Result<void> RecordingReader::load_frame(size_t i, Image* out, DecodeBuffers* bu
   try {
     return decode_frame(i, out, buffers);
   } catch (const std::bad_alloc&) {
-    return make_error(frame_context(i) + ": " + out_of_memory_text(buffers->info));
+    // The message needs memory too; if there is none, the bad_alloc of its
+    // making goes to the caller (FramePrefetcher names it later).
+    return make_error(out_of_memory_error(i));
   }
+}
+
+std::string RecordingReader::out_of_memory_error(size_t i) const {
+  return frame_context(i) + ": " +
+         out_of_memory_text(camera_.intrinsics.width, camera_.intrinsics.height);
 }
 
 Result<void> RecordingReader::decode_frame(size_t i, Image* out, DecodeBuffers* buffers) const {
@@ -560,7 +580,7 @@ Result<void> RecordingReader::decode_frame(size_t i, Image* out, DecodeBuffers* 
     return make_error(frame_context(i) + ": " +
                       (memory_for(info) ? std::string("corrupt ") + to_string(info.encoding) +
                                               " data (decoder failed)"
-                                        : out_of_memory_text(info)));
+                                        : out_of_memory_text(info.width, info.height)));
   };
   // Grey frames decode straight into `out`; colour frames go through the
   // reused BGR buffer because OpenCV decodes to BGR and we hand out RGB.
@@ -586,7 +606,7 @@ Result<void> RecordingReader::decode_frame(size_t i, Image* out, DecodeBuffers* 
     }
   } catch (const cv::Exception& e) {
     if (e.code == cv::Error::StsNoMem || !memory_for(info))
-      return make_error(frame_context(i) + ": " + out_of_memory_text(info));
+      return make_error(frame_context(i) + ": " + out_of_memory_text(info.width, info.height));
     return make_error(frame_context(i) + ": corrupt " + to_string(info.encoding) + " data (" +
                       e.what() + ")");
   }

@@ -77,6 +77,9 @@ class RecordingReader {
 
   // "<dir>/<file> (frames.csv:<line>)": how errors about frame i name it.
   std::string frame_context(size_t i) const;
+  // The error of frame i when memory ran out decoding it. Throws
+  // std::bad_alloc if even this message cannot be made.
+  std::string out_of_memory_error(size_t i) const;
 
  private:
   RecordingReader();
