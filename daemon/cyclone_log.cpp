@@ -21,6 +21,11 @@ spdlog::level::level_enum level_of(uint32_t priority) {
   return spdlog::level::debug;
 }
 
+void log_dropped(uint64_t dropped) {
+  spdlog::warn("dds: {} messages of Cyclone DDS dropped (rate limit {} a second)", dropped,
+               kLinesPerS);
+}
+
 void write_cyclone_line(void* limit, const dds_log_data_t* data) {
   uint64_t dropped = 0;
   if (!static_cast<LogRateLimit*>(limit)->admit(monotonic_ns(), &dropped)) return;
@@ -28,9 +33,7 @@ void write_cyclone_line(void* limit, const dds_log_data_t* data) {
   std::string_view text(data->message, data->size);
   text.remove_prefix(std::min(data->hdrsize, text.size()));
   while (!text.empty() && (text.back() == '\n' || text.back() == '\r')) text.remove_suffix(1);
-  if (dropped > 0)
-    spdlog::warn("dds: {} messages of Cyclone DDS dropped (rate limit {} a second)", dropped,
-                 kLinesPerS);
+  if (dropped > 0) log_dropped(dropped);
   spdlog::log(level_of(data->priority), "dds: {}", text);
 }
 
@@ -71,9 +74,7 @@ LogRateLimit& cyclone_limit() {
 void route_cyclone_log() { dds_set_log_sink(&write_cyclone_line, &cyclone_limit()); }
 
 void report_dropped_cyclone_lines() {
-  if (const uint64_t dropped = cyclone_limit().take_dropped(); dropped > 0)
-    spdlog::warn("dds: {} messages of Cyclone DDS dropped (rate limit {} a second)", dropped,
-                 kLinesPerS);
+  if (const uint64_t dropped = cyclone_limit().take_dropped(); dropped > 0) log_dropped(dropped);
 }
 
 }  // namespace ceilpose::daemon

@@ -4,23 +4,19 @@
 #include <cmath>
 
 #include "core/clock.h"
+#include "core/finite.h"
 
 namespace ceilpose {
 namespace {
 
-bool all_finite(const double* v, size_t n) {
-  return std::all_of(v, v + n, [](double x) { return std::isfinite(x); });
-}
-
 bool finite_estimate(const PoseEstimate& e) {
   const double pose[] = {e.pose.x_m, e.pose.y_m, e.pose.yaw_rad, e.rms_residual_px,
                          e.time_offset_s};
-  return all_finite(pose, std::size(pose)) && all_finite(e.covariance.data(), e.covariance.size());
+  return all_finite(pose) && all_finite(e.covariance);
 }
 
 bool finite_motion(const MotionEstimate& m) {
-  return !m.valid || (all_finite(m.state.x.data(), m.state.x.size()) &&
-                      all_finite(m.state.p.data(), m.state.p.size()));
+  return !m.valid || (all_finite(m.state.x) && all_finite(m.state.p));
 }
 
 }  // namespace

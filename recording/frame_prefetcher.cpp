@@ -31,8 +31,7 @@ FramePrefetcher::FramePrefetcher(const RecordingReader& reader, int threads, siz
       next_claim_(std::min(first, reader.rows().size())),
       next_out_(next_claim_) {
   const CameraIntrinsics& k = reader.camera().intrinsics;
-  threads = threads_within_budget(threads, static_cast<size_t>(std::max(k.width, 0)) *
-                                               static_cast<size_t>(std::max(k.height, 0)) * 3);
+  threads = threads_within_budget(threads, decoded_frame_bytes(k.width, k.height));
   // One slot per worker to decode into, one the consumer holds, one spare so
   // that a worker never waits for the consumer to finish a frame.
   slots_.resize(static_cast<size_t>(threads) + 2);

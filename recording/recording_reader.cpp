@@ -539,7 +539,7 @@ namespace {
 // own allocation failures and only says the data is corrupt (issue 28), so
 // a failed decode tries to allocate what it needed before blaming the file.
 std::string out_of_memory_text(int width, int height) {
-  const size_t bytes = static_cast<size_t>(width) * static_cast<size_t>(height) * 3;
+  const size_t bytes = decoded_frame_bytes(width, height);
   return "not enough memory to decode this " + std::to_string(width) + "x" +
          std::to_string(height) + " frame (" + std::to_string(bytes >> 20) +
          " MiB decoded, twice that while decoding): raise the address-space limit (ulimit -v, "
@@ -547,7 +547,7 @@ std::string out_of_memory_text(int width, int height) {
 }
 
 bool memory_for(const FrameFileInfo& info) {
-  const size_t bytes = static_cast<size_t>(info.width) * static_cast<size_t>(info.height) * 3;
+  const size_t bytes = decoded_frame_bytes(info.width, info.height);
   std::unique_ptr<uint8_t[]> probe(new (std::nothrow) uint8_t[2 * bytes]);
   return probe != nullptr;
 }

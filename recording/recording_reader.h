@@ -40,6 +40,13 @@ struct RecordingRow {
   int csv_line = 0;  // 1-based line of this row in frames.csv (the header is line 1)
 };
 
+// Bytes of one decoded RGB frame of `width` x `height`: what decoding holds
+// per copy of a frame.
+inline size_t decoded_frame_bytes(int width, int height) {
+  return static_cast<size_t>(width > 0 ? width : 0) * static_cast<size_t>(height > 0 ? height : 0) *
+         3;
+}
+
 class RecordingReader {
  public:
   // Parses and validates recording.yaml and all of frames.csv (and that every

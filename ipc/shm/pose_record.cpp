@@ -4,6 +4,8 @@
 #include <cmath>
 #include <cstring>
 
+#include "core/finite.h"
+
 namespace ceilpose {
 
 const char* to_string(WriterState state) {
@@ -24,19 +26,12 @@ const char* pose_mode_name(uint8_t mode) {
                                          : "unknown";
 }
 
-namespace {
-bool all_finite(const double* v, size_t n) {
-  return std::all_of(v, v + n, [](double x) { return std::isfinite(x); });
-}
-}  // namespace
-
 bool pose_numbers_finite(const PoseRecord& p) {
   const double scalars[] = {p.x_m,     p.y_m,     p.yaw_rad,
                             p.vx_mps,  p.vy_mps,  p.yaw_rate_radps,
                             p.ax_mps2, p.ay_mps2, p.yaw_accel_radps2};
-  return all_finite(scalars, std::size(scalars)) && all_finite(p.covariance, 9) &&
-         all_finite(p.state_covariance, std::size(p.state_covariance)) &&
-         all_finite(p.jerk_density, 3);
+  return all_finite(scalars) && all_finite(p.covariance) && all_finite(p.state_covariance) &&
+         all_finite(p.jerk_density);
 }
 
 void make_publishable(PoseRecord* p) {
