@@ -13,10 +13,12 @@
 #include <map>
 #include <sstream>
 #include <thread>
+#include <vector>
 
 #include "core/exit_codes.h"
 #include "ipc/shm/shm_pose_reader.h"
 #include "ipc/shm/shm_pose_writer.h"
+#include "pipeline/accuracy_metrics.h"
 #include "tests/daemon/daemon_process.h"
 #include "tests/daemon/stopped_thread.h"
 #include "tests/ipc/dds/dds_test_env.h"
@@ -130,7 +132,14 @@ TEST_F(DaemonLifecycle, SigtermStopsWithinASecondWithExitZeroAndSegmentMarkedSto
 }
 
 // Issue 13: with the filter on, every pose carries the filter's motion, and
-// the synthetic patrol's 1.2 m/s shows in it.
+// the synthetic patrol's 1.2 m/s shows in it. Not in every pose: the
+// synthetic camera samples edges without anti-aliasing, so rectangle
+// centroids move in 0.5 px steps, and on the two frames after a marker row
+// enters the view that pattern reads as a 0.17° tilt: the pose is 7 mm off
+// and the filter's speed 1.04-1.08 m/s with an sd of 0.08 (a CI run that
+// started late read one of them). So: the median of two seconds of poses
+// holds the speed, and each pose's speed lies within 4 sd of its own
+// covariance.
 TEST_F(DaemonLifecycle, FilteredPosesCarryVelocityForPrediction) {
   config_ = write_temp_file("ceilpose.yaml",
                             "filter:\n  enabled: true\nwatchdog:\n  status_interval_ms: 200\n"
@@ -139,18 +148,35 @@ TEST_F(DaemonLifecycle, FilteredPosesCarryVelocityForPrediction) {
   ASSERT_TRUE(notify_.wait_for("READY=1", kStartTimeoutMs)) << daemon->err();
   auto reader = ShmPoseReader::open_waiting(shm_, 5000);
   ASSERT_TRUE(reader) << reader.error().message;
+  constexpr double kSpeed_mps = 1.2, kAhead_s = 0.05;
+  // State order (pose_client.h): x, y, yaw, vx, vy, yaw rate, ax, ay, yaw acceleration.
+  constexpr int kPoses = 60;
   PoseRecord pose{};
-  for (int k = 0; k < 30; ++k) {  // let the velocity settle
+  std::vector<double> speeds_mps, aheads_m;
+  int beyond_4_sd = 0;
+  for (int k = 0; k < kPoses; ++k) {
     pose = next_pose(*reader, pose.seq);
     ASSERT_NE(pose.seq, 0u) << daemon->err();
+    ASSERT_TRUE(pose_is_valid(pose)) << "pose " << k;
+    ASSERT_NE(pose.flags & kPoseMotion, 0u) << "pose " << k;
+    EXPECT_EQ(pose.predict_horizon_ms, 200u);
+    const double speed_mps = std::hypot(pose.vx_mps, pose.vy_mps);
+    const double sd_mps = std::sqrt(0.5 * (pose.state_covariance[3 * CEILPOSE_STATE_SIZE + 3] +
+                                           pose.state_covariance[4 * CEILPOSE_STATE_SIZE + 4]));
+    if (std::abs(speed_mps - kSpeed_mps) > 4.0 * sd_mps) ++beyond_4_sd;
+    speeds_mps.push_back(speed_mps);
+    PoseRecord ahead{};
+    ASSERT_EQ(
+        predict_pose(pose, pose.capture_mono_ns + static_cast<int64_t>(kAhead_s * 1e9), &ahead),
+        PredictResult::kOk);
+    aheads_m.push_back(std::hypot(ahead.x_m - pose.x_m, ahead.y_m - pose.y_m));
   }
-  ASSERT_TRUE(pose_is_valid(pose));
-  ASSERT_NE(pose.flags & kPoseMotion, 0u);
-  EXPECT_NEAR(std::hypot(pose.vx_mps, pose.vy_mps), 1.2, 0.05);
-  EXPECT_EQ(pose.predict_horizon_ms, 200u);
-  PoseRecord ahead{};
-  ASSERT_EQ(predict_pose(pose, pose.capture_mono_ns + 50'000'000, &ahead), PredictResult::kOk);
-  EXPECT_NEAR(std::hypot(ahead.x_m - pose.x_m, ahead.y_m - pose.y_m), 0.06, 0.005);
+  // Measured: median 1.206 m/s and 60.3 mm; none beyond 4 sd.
+  std::sort(speeds_mps.begin(), speeds_mps.end());
+  std::sort(aheads_m.begin(), aheads_m.end());
+  EXPECT_NEAR(percentile(speeds_mps, 0.5), kSpeed_mps, 0.015);
+  EXPECT_NEAR(percentile(aheads_m, 0.5), kSpeed_mps * kAhead_s, 0.001);
+  EXPECT_EQ(beyond_4_sd, 0) << "poses whose speed is over 4 sd of their own covariance off";
   daemon->signal(SIGTERM);
   ASSERT_TRUE(daemon->wait(5000).has_value()) << daemon->err();
 }
