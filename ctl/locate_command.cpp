@@ -32,6 +32,7 @@ class JsonLinesSink final : public PoseSink {
     const int64_t proc_us = (loc.localize_ns + 500) / 1000;
     // An invalid frame names the mode that was asked for: none was used.
     const std::string_view mode = to_string(e.valid ? e.mode : requested_);
+    const char* sweep = loc.tracked() ? "tracked" : "full";
     if (e.valid) {
       Pose2D pose = e.pose;
       std::array<double, 9> cov = e.covariance;
@@ -45,10 +46,11 @@ class JsonLinesSink final : public PoseSink {
       std::printf("{\"index\":%" PRId64 ",\"timestamp_ns\":%" PRId64
                   ",\"valid\":true%s"
                   ",\"mode\":\"%.*s\",\"markers\":%d,\"proc_us\":%" PRId64
-                  ",\"refusal\":null,\"rms_px\":%.3f,\"cov\":[%.3e,%.3e,%.3e,%.3e,%.3e,%.3e]",
+                  ",\"sweep\":\"%s\",\"refusal\":null,\"rms_px\":%.3f,"
+                  "\"cov\":[%.3e,%.3e,%.3e,%.3e,%.3e,%.3e]",
                   loc.frame.index, loc.frame.timestamp_ns, pose_fields_json(&pose).c_str(),
-                  static_cast<int>(mode.size()), mode.data(), e.markers, proc_us, e.rms_residual_px,
-                  cov[0], cov[1], cov[2], cov[4], cov[5], cov[8]);
+                  static_cast<int>(mode.size()), mode.data(), e.markers, proc_us, sweep,
+                  e.rms_residual_px, cov[0], cov[1], cov[2], cov[4], cov[5], cov[8]);
       if (loc.motion.valid)
         std::printf(",\"vx_mps\":%.6f,\"vy_mps\":%.6f,\"yaw_rate_radps\":%.6f", motion.x[3],
                     motion.x[4], motion.x[5]);
@@ -58,9 +60,10 @@ class JsonLinesSink final : public PoseSink {
       const std::string_view refusal = to_string(e.refusal);
       std::printf("{\"index\":%" PRId64 ",\"timestamp_ns\":%" PRId64
                   ",\"valid\":false%s"
-                  ",\"mode\":\"%.*s\",\"markers\":%d,\"proc_us\":%" PRId64 ",\"refusal\":\"%.*s\"",
+                  ",\"mode\":\"%.*s\",\"markers\":%d,\"proc_us\":%" PRId64
+                  ",\"sweep\":\"%s\",\"refusal\":\"%.*s\"",
                   loc.frame.index, loc.frame.timestamp_ns, pose_fields_json(nullptr).c_str(),
-                  static_cast<int>(mode.size()), mode.data(), e.markers, proc_us,
+                  static_cast<int>(mode.size()), mode.data(), e.markers, proc_us, sweep,
                   static_cast<int>(refusal.size()), refusal.data());
       if (predict_ms_) std::printf(",\"predict_ms\":%.3f", *predict_ms_);
       std::fputs("}\n", stdout);
@@ -80,7 +83,9 @@ void add_locate_command(CLI::App& app) {
       "locate",
       "Localize every frame of a recording in order, as fast as possible; one JSON object per "
       "frame on stdout (SPEC §5): index, timestamp_ns, valid, x_m, y_m, yaw_rad (null when "
-      "invalid), mode, markers, proc_us, refusal (why an invalid frame has no pose, e.g. "
+      "invalid), mode, markers, proc_us, sweep (\"tracked\": with --filter's fix only the "
+      "windows where the markers were predicted were swept; \"full\": the whole frame), refusal "
+      "(why an invalid frame has no pose, e.g. "
       "no_markers, wrong_heights; null when valid), and for valid frames rms_px and cov (the "
       "upper triangle of the (x, y, yaw) covariance: xx, xy, xyaw, yy, yyaw, yawyaw); with "
       "--filter also vx_mps, vy_mps (world frame) and yaw_rate_radps, with --predict-ms MS the "

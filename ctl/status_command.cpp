@@ -76,7 +76,9 @@ void print_json(const StatusArgs& args, const Snapshot& s) {
            ",\"p99\":" + std::to_string(st.latency_p99_us) +
            ",\"max\":" + std::to_string(st.latency_max_us) + "}" +
            ",\"fix\":" + json_quote(to_string(static_cast<FixState>(st.fix_state))) +
-           ",\"source\":" + json_quote(st.source) + ",\"refusals\":{";
+           ",\"source\":" + json_quote(st.source) +
+           ",\"tracked_frames\":" + std::to_string(st.tracked_frames) +
+           ",\"full_sweep_frames\":" + std::to_string(st.full_sweep_frames) + ",\"refusals\":{";
     bool first = true;
     for_each_refusal(st, [&](const std::string& name, uint64_t count) {
       if (name == to_string(Refusal::kNone)) return;
@@ -89,7 +91,8 @@ void print_json(const StatusArgs& args, const Snapshot& s) {
   } else {
     out +=
         ",\"fps\":null,\"frames\":null,\"drops\":null,\"skipped\":null,\"outages\":null,"
-        "\"latency_us\":null,\"fix\":null,\"source\":null,\"refusals\":null,"
+        "\"latency_us\":null,\"fix\":null,\"source\":null,\"tracked_frames\":null,"
+        "\"full_sweep_frames\":null,\"refusals\":null,"
         "\"localized\":null,\"status_age_ms\":null";
   }
   out += ",\"last_seq\":" + (s.has_pose ? std::to_string(s.pose.seq) : std::string("null")) +
@@ -120,6 +123,11 @@ void print_human(const StatusArgs& args, const Snapshot& s) {
         "  (capture -> pose published)\n",
         st.latency_p50_us / 1e3, st.latency_p90_us / 1e3, st.latency_p99_us / 1e3,
         st.latency_max_us / 1e3);
+    const double swept = static_cast<double>(st.tracked_frames) + st.full_sweep_frames;
+    std::printf("  sweeps     %" PRIu32 " tracked (%.0f %%), %" PRIu32
+                " whole  (frames since start; tracked: only where the markers were predicted)\n",
+                st.tracked_frames, swept > 0 ? 100.0 * st.tracked_frames / swept : 0.0,
+                st.full_sweep_frames);
     std::string refused;
     for_each_refusal(st, [&](const std::string& name, uint64_t count) {
       if (count == 0 || name == to_string(Refusal::kNone)) return;

@@ -160,6 +160,7 @@ void PipelineWorker::publish_status(int64_t now_ns, bool all) {
   status.mode = last_.mode;
   status.markers = last_.markers;
   status.refusals = localizer_.refusals().snapshot();
+  status.sweeps = localizer_.sweeps();
   for (size_t i = 0; i < sinks_.size(); ++i) {
     if (!all && now_ns < next_status_ns_[i]) continue;
     next_status_ns_[i] = now_ns + sinks_[i]->status_period_ns();

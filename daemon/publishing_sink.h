@@ -7,6 +7,7 @@
 #include "capture/latency_histogram.h"
 #include "core/fix_state.h"
 #include "core/refusal.h"
+#include "pipeline/localizer.h"
 #include "pipeline/pose_estimate.h"
 #include "pipeline/pose_sink.h"
 
@@ -25,6 +26,7 @@ struct ServiceStatus {
   PositioningMode mode = PositioningMode::kAuto;  // of the latest published pose
   int markers = 0;                                // of the latest published pose
   RefusalHistogram::Counts refusals{};            // frames per refusal since start
+  SweepCounts sweeps;                             // frames tracked / swept whole since start
 };
 
 class PublishingSink : public PoseSink {

@@ -24,6 +24,9 @@ void ShmPoseSink::publish_status(const ServiceStatus& s) {
   status.latency_max_us = static_cast<uint32_t>(s.latency.max_us);
   status.fix_state = static_cast<uint32_t>(s.fix);
   status.refusal_count = static_cast<uint32_t>(s.refusals.size());
+  // Modulo 2^32 (the ABI's reserved words): readers take differences.
+  status.tracked_frames = static_cast<uint32_t>(s.sweeps.tracked());
+  status.full_sweep_frames = static_cast<uint32_t>(s.sweeps.full());
   std::copy(s.refusals.begin(), s.refusals.end(), status.refusals);
   set_status_source(&status, s.source);
   writer_->update_status(status);

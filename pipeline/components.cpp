@@ -1,5 +1,6 @@
 #include "pipeline/components.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstring>
 
@@ -52,12 +53,11 @@ void ComponentLabeler::resize(int width_px, int height_px) {
   comp_count_ = 0;
 }
 
-void ComponentLabeler::classify_row(const ImageView& frame, int y,
-                                    const ColorClassifier& classifier) {
-  const uint8_t* p = frame.row(y);
+void ComponentLabeler::classify_span(const ImageView& frame, int y, int x0, int x1,
+                                     const ColorClassifier& classifier) {
+  const uint8_t* row = frame.row(y);
   uint8_t* out = row_class_.data();
   const uint8_t* lut = classifier.lut();
-  const int w = width_;
   switch (frame.format) {
     case PixelFormat::kRgb24:
     case PixelFormat::kBgr24: {
@@ -65,40 +65,47 @@ void ComponentLabeler::classify_row(const ImageView& frame, int y,
       const uint32_t* t0 = classifier.table(rgb ? 0 : 2);
       const uint32_t* t1 = classifier.table(1);
       const uint32_t* t2 = classifier.table(rgb ? 2 : 0);
-      for (int x = 0; x < w; ++x, p += 3) out[x] = lut[t0[p[0]] | t1[p[1]] | t2[p[2]]];
+      const uint8_t* p = row + 3 * x0;
+      for (int x = x0; x <= x1; ++x, p += 3) out[x] = lut[t0[p[0]] | t1[p[1]] | t2[p[2]]];
       return;
     }
     case PixelFormat::kYuyv: {
+      // Y0 U Y1 V per pixel pair: a pair shares its chroma.
       const uint32_t* tr = classifier.table(0);
       const uint32_t* tg = classifier.table(1);
       const uint32_t* tb = classifier.table(2);
       uint8_t r = 0, g = 0, b = 0;
-      int x = 0;
-      for (; x + 1 < w; x += 2, p += 4) {
-        yuv_to_rgb(p[0], p[1], p[3], &r, &g, &b);
+      auto one = [&](int x) {
+        const uint8_t* q = row + 4 * (x / 2);
+        yuv_to_rgb(q[(x & 1) * 2], q[1], q[3], &r, &g, &b);
         out[x] = lut[tr[r] | tg[g] | tb[b]];
-        yuv_to_rgb(p[2], p[1], p[3], &r, &g, &b);
+      };
+      int x = x0;
+      if ((x & 1) != 0) one(x++);
+      for (const uint8_t* q = row + 2 * x; x + 1 <= x1; x += 2, q += 4) {
+        yuv_to_rgb(q[0], q[1], q[3], &r, &g, &b);
+        out[x] = lut[tr[r] | tg[g] | tb[b]];
+        yuv_to_rgb(q[2], q[1], q[3], &r, &g, &b);
         out[x + 1] = lut[tr[r] | tg[g] | tb[b]];
       }
-      if (x < w) {
-        yuv_to_rgb(p[0], p[1], p[3], &r, &g, &b);
-        out[x] = lut[tr[r] | tg[g] | tb[b]];
-      }
+      if (x <= x1) one(x);
       return;
     }
     case PixelFormat::kGray8:
     case PixelFormat::kMjpeg:
-      std::memset(out, 0, static_cast<size_t>(w));
+      std::memset(out + x0, 0, static_cast<size_t>(x1 - x0 + 1));
       return;
   }
 }
 
-bool ComponentLabeler::encode_row(int y) {
+// Runs of row y between x0 and x1; the row buffer is zero outside the
+// classified spans and for kRowPadding bytes past the row.
+bool ComponentLabeler::encode_row(int y, int x0, int x1) {
   const uint8_t* c = row_class_.data();
-  const int w = width_;
+  const int w = x1 + 1;
   const int row_begin = run_count_;
   constexpr auto kDark = static_cast<uint8_t>(PixelClass::kDark);
-  int x = 0;
+  int x = x0;
   while (x < w) {
     uint64_t word = 0;
     std::memcpy(&word, c + x, sizeof word);
@@ -109,16 +116,16 @@ bool ComponentLabeler::encode_row(int y) {
     while (c[x] == 0) ++x;
     if (x >= w) break;
     const uint8_t cls = c[x];
-    const int x0 = x;
+    const int run_x0 = x;
     while (c[x] == cls) ++x;  // stops at the zero padding at the latest
-    const int x1 = x - 1;
+    const int run_x1 = x - 1;
     const int in_row = run_count_ - row_begin;
     if (cls == kDark) {
       // Keep a dark run only while it may still be enclosed: it must start
       // right after a coloured run.
-      if (in_row > 0 && runs_[run_count_ - 1].x1 + 1 == x0) {
-        if (run_count_ >= max_runs_) return false;
-        runs_[run_count_++] = Run{x0, x1, y, 0, PixelClass::kDark};
+      if (in_row > 0 && runs_[run_count_ - 1].x1 + 1 == run_x0) {
+        if (run_count_ >= run_budget_) return false;
+        runs_[run_count_++] = Run{run_x0, run_x1, y, 0, PixelClass::kDark};
       }
       continue;
     }
@@ -126,14 +133,14 @@ bool ComponentLabeler::encode_row(int y) {
       const Run dark = runs_[run_count_ - 1];
       --run_count_;
       Run& left = runs_[run_count_ - 1];
-      if (dark.x1 + 1 == x0 && static_cast<uint8_t>(left.cls) == cls) {
+      if (dark.x1 + 1 == run_x0 && static_cast<uint8_t>(left.cls) == cls) {
         left.dark_px += dark.x1 - dark.x0 + 1;
-        left.x1 = x1;
+        left.x1 = run_x1;
         continue;
       }
     }
-    if (run_count_ >= max_runs_) return false;
-    runs_[run_count_] = Run{x0, x1, y, 0, static_cast<PixelClass>(cls)};
+    if (run_count_ >= run_budget_) return false;
+    runs_[run_count_] = Run{run_x0, run_x1, y, 0, static_cast<PixelClass>(cls)};
     parent_[run_count_] = run_count_;
     ++run_count_;
   }
@@ -170,7 +177,7 @@ void ComponentLabeler::join_rows(int prev_begin, int prev_end, int cur_begin, in
   }
 }
 
-void ComponentLabeler::accumulate() {
+void ComponentLabeler::accumulate(std::span<const PixelWindow> windows) {
   comp_count_ = 0;
   for (int i = 0; i < run_count_; ++i) {
     const Run& run = runs_[i];
@@ -216,31 +223,107 @@ void ComponentLabeler::accumulate() {
     c.mu20 = s[2] / a - c.cx * c.cx;
     c.mu11 = s[3] / a - c.cx * c.cy;
     c.mu02 = s[4] / a - c.cy * c.cy;
-    c.touches_border =
-        c.x_min == 0 || c.y_min == 0 || c.x_max == width_ - 1 || c.y_max == height_ - 1;
+    // Its window's edges (the frame's for a full sweep): windows neither
+    // overlap nor touch, so the blob lies in exactly one.
+    for (const PixelWindow& w : windows) {
+      if (c.x_min < w.x0 || c.x_max > w.x1 || c.y_min < w.y0 || c.y_max > w.y1) continue;
+      c.touches_border = c.x_min == w.x0 || c.y_min == w.y0 || c.x_max == w.x1 || c.y_max == w.y1;
+      const bool inner_edge = (c.x_min == w.x0 && w.x0 > 0) || (c.y_min == w.y0 && w.y0 > 0) ||
+                              (c.x_max == w.x1 && w.x1 < width_ - 1) ||
+                              (c.y_max == w.y1 && w.y1 < height_ - 1);
+      if (inner_edge && c.cls != PixelClass::kDark && 4 * c.area_px >= params_.min_rect_area_px) {
+        ++window_cuts_;
+      }
+      break;
+    }
   }
 }
 
 bool ComponentLabeler::label(const ImageView& frame, const ColorClassifier& classifier) {
+  const PixelWindow whole{0, 0, width_ - 1, height_ - 1};
+  run_budget_ = max_runs_;
+  return sweep_rows(frame, classifier, std::span<const PixelWindow>(&whole, 1));
+}
+
+bool ComponentLabeler::label(const ImageView& frame, const ColorClassifier& classifier,
+                             std::span<const PixelWindow> windows) {
+  int64_t pixels = 0;
+  for (const PixelWindow& w : windows) {
+    if (w.empty() || w.x0 < 0 || w.y0 < 0 || w.x1 >= width_ || w.y1 >= height_) {
+      run_count_ = 0;
+      comp_count_ = 0;
+      return false;
+    }
+    pixels += w.area_px();
+  }
+  run_budget_ = std::min(max_runs_, std::max(1024, static_cast<int>(static_cast<double>(pixels) *
+                                                                    params_.max_runs_per_pixel)));
+  return sweep_rows(frame, classifier, windows);
+}
+
+bool ComponentLabeler::sweep_rows(const ImageView& frame, const ColorClassifier& classifier,
+                                  std::span<const PixelWindow> windows) {
   run_count_ = 0;
   comp_count_ = 0;
+  window_cuts_ = 0;
   if (frame.width != width_ || frame.height != height_ || frame.empty()) return false;
   // Grey frames carry no colour: nothing can be red or green.
   if (frame.format == PixelFormat::kGray8 || frame.format == PixelFormat::kMjpeg) return true;
+  int y_begin = height_, y_end = -1;
+  for (const PixelWindow& w : windows) {
+    y_begin = std::min(y_begin, w.y0);
+    y_end = std::max(y_end, w.y1);
+  }
   int prev_begin = 0, prev_end = 0;
-  for (int y = 0; y < height_; ++y) {
-    classify_row(frame, y, classifier);
+  for (int y = y_begin; y <= y_end; ++y) {
+    int lo = width_, hi = -1;
+    for (const PixelWindow& w : windows) {
+      if (y < w.y0 || y > w.y1) continue;
+      classify_span(frame, y, w.x0, w.x1, classifier);
+      lo = std::min(lo, w.x0);
+      hi = std::max(hi, w.x1);
+    }
     const int cur_begin = run_count_;
-    if (!encode_row(y)) {
-      run_count_ = 0;
-      return false;
+    if (hi >= lo) {
+      const bool ok = encode_row(y, lo, hi);
+      // Outside the spans the buffer stays zero (encode_row relies on it).
+      std::memset(row_class_.data() + lo, 0, static_cast<size_t>(hi - lo + 1));
+      if (!ok) {
+        run_count_ = 0;
+        return false;
+      }
     }
     join_rows(prev_begin, prev_end, cur_begin, run_count_);
     prev_begin = cur_begin;
     prev_end = run_count_;
   }
-  accumulate();
+  accumulate(windows);
   return true;
+}
+
+int merge_windows(std::span<PixelWindow> windows, int count) {
+  // Windows that overlap or touch (diagonals included: a blob could join
+  // them) become their bounding box, until none do.
+  auto touch = [](const PixelWindow& a, const PixelWindow& b) {
+    return a.x0 <= b.x1 + 1 && b.x0 <= a.x1 + 1 && a.y0 <= b.y1 + 1 && b.y0 <= a.y1 + 1;
+  };
+  bool merged = true;
+  while (merged) {
+    merged = false;
+    for (int i = 0; i < count && !merged; ++i) {
+      for (int j = i + 1; j < count; ++j) {
+        if (!touch(windows[i], windows[j])) continue;
+        PixelWindow& a = windows[i];
+        const PixelWindow& b = windows[j];
+        a = {std::min(a.x0, b.x0), std::min(a.y0, b.y0), std::max(a.x1, b.x1),
+             std::max(a.y1, b.y1)};
+        windows[j] = windows[--count];
+        merged = true;
+        break;
+      }
+    }
+  }
+  return count;
 }
 
 }  // namespace ceilpose

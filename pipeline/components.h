@@ -17,12 +17,22 @@
 
 namespace ceilpose {
 
+// A rectangle of the frame to sweep, pixels, inclusive bounds.
+struct PixelWindow {
+  int x0 = 0, y0 = 0, x1 = -1, y1 = -1;
+  bool empty() const { return x1 < x0 || y1 < y0; }
+  int64_t area_px() const { return empty() ? 0 : int64_t{x1 - x0 + 1} * (y1 - y0 + 1); }
+  bool operator==(const PixelWindow&) const = default;
+};
+
 struct Component {
   PixelClass cls = PixelClass::kBackground;
   int area_px = 0;  // pixels, dots included
   int dark_px = 0;  // enclosed dark pixels among area_px
   int x_min = 0, x_max = 0, y_min = 0, y_max = 0;
-  bool touches_border = false;  // some pixel lies on the outermost row/column
+  // Some pixel lies on the outermost row/column of the frame, or of the
+  // window it was found in (a tracked sweep): the blob may continue beyond.
+  bool touches_border = false;
   // Centroid (pixel centres at integer coordinates, SPEC §3) and second
   // central moments per pixel: mu20 = E[(x−cx)²], mu11, mu02.
   double cx = 0.0, cy = 0.0;
@@ -47,9 +57,17 @@ class ComponentLabeler {
   // budget (`max_runs_per_pixel`): noise, not a ceiling. GRAY8 frames hold
   // no colour and give no components. Hot path: no allocation.
   bool label(const ImageView& frame, const ColorClassifier& classifier);
+  // The same, within `windows` only (a tracked sweep): they must lie inside
+  // the frame and not overlap (merge_windows); the run budget is that of
+  // the windows' pixels. A component on a window's edge touches_border.
+  bool label(const ImageView& frame, const ColorClassifier& classifier,
+             std::span<const PixelWindow> windows);
 
   std::span<const Component> components() const { return {comps_.data(), comp_count_}; }
   int run_count() const { return run_count_; }
+  // Red or green blobs of a tracked sweep on a window edge inside the frame
+  // (a marker where the windows did not expect it); 0 for a full sweep.
+  int window_cut_count() const { return window_cuts_; }
 
  private:
   struct Run {
@@ -58,17 +76,21 @@ class ComponentLabeler {
     PixelClass cls;
   };
 
-  void classify_row(const ImageView& frame, int y, const ColorClassifier& classifier);
-  bool encode_row(int y);
+  void classify_span(const ImageView& frame, int y, int x0, int x1,
+                     const ColorClassifier& classifier);
+  bool encode_row(int y, int x0, int x1);
+  bool sweep_rows(const ImageView& frame, const ColorClassifier& classifier,
+                  std::span<const PixelWindow> windows);
   void join_rows(int prev_begin, int prev_end, int cur_begin, int cur_end);
   int32_t find(int32_t i);
   void unite(int32_t a, int32_t b);
-  void accumulate();
+  void accumulate(std::span<const PixelWindow> windows);
 
   DetectorParams params_;
   int width_ = 0;
   int height_ = 0;
   int max_runs_ = 0;
+  int run_budget_ = 0;              // this sweep's: max_runs_, or the windows' share
   std::vector<uint8_t> row_class_;  // width + 8 bytes of padding
   std::vector<Run> runs_;
   std::vector<int32_t> parent_;
@@ -77,6 +99,11 @@ class ComponentLabeler {
   std::vector<std::array<double, 5>> sums_;  // Σx, Σy, Σx², Σxy, Σy² per component
   int run_count_ = 0;
   size_t comp_count_ = 0;
+  int window_cuts_ = 0;
 };
+
+// Merges windows that overlap or touch into their bounding boxes, in place;
+// returns how many remain (the first ones of `windows`).
+int merge_windows(std::span<PixelWindow> windows, int count);
 
 }  // namespace ceilpose

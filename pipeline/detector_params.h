@@ -124,6 +124,22 @@ struct DetectorParams {
   // fainter dots.
   float quality_full_margin = 0.3f;
   float quality_zero_pair_score = 4.0f;
+
+  // --- tracking (marker_tracking.cpp) ---
+  // With the filter's fix, sweep only the windows where the markers will be
+  // (issue 29); the whole frame when the fix is lost, when a window comes
+  // back without its marker, and every full_sweep_every frames (1 s at 30
+  // fps; 1 = never track). Markers entering the view need no full sweep:
+  // every marker of the map the view can hold gets a window.
+  bool tracking = true;
+  int full_sweep_every = 30;
+  // Window margin around a marker's predicted outline: this many pixels...
+  float track_margin_px = 4.0f;
+  // ...plus this many times the largest error of the last three one-frame
+  // predictions (position, and yaw at the frame's corners).
+  float track_margin_errors = 3.0f;
+  // Windows covering more than this share of the frame: sweep it whole.
+  float track_max_area_share = 0.6f;
 };
 
 }  // namespace ceilpose

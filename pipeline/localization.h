@@ -10,6 +10,7 @@
 #include "core/motion_model.h"
 #include "core/pose.h"
 #include "core/refusal.h"
+#include "pipeline/marker_tracking.h"
 #include "pipeline/pipeline.h"
 #include "pipeline/pose_estimate.h"
 
@@ -47,10 +48,15 @@ struct Localization {
   // valid until the next frame is localized.
   ImageView image;
   const Pipeline* detection = nullptr;
+  // How the frame was swept: kNone tracked (windows only), else why whole
+  // (a failed tracked sweep is followed by a whole one of the same frame).
+  FullSweepReason sweep = FullSweepReason::kOff;
+  int64_t swept_px = 0;  // pixels classified, both sweeps of a failed track included
   std::array<int64_t, kStageCount> stage_ns{};  // duration of each pipeline stage
   int64_t localize_ns = 0;                      // whole localization, filter included
 
   bool coasting() const { return published.valid && !measured.valid; }
+  bool tracked() const { return sweep == FullSweepReason::kNone; }
 };
 
 }  // namespace ceilpose

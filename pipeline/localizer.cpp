@@ -28,12 +28,18 @@ PipelineConfig with_mode(PipelineConfig config, PositioningMode mode, bool filte
 }
 
 Localizer::Localizer(const PipelineConfig& config)
-    : pipeline_(config), filter_(config.filter), result_(std::make_unique<FrameResult>()) {}
+    : pipeline_(config),
+      filter_(config.filter),
+      view_(config),
+      result_(std::make_unique<FrameResult>()) {}
 
 void Localizer::reconfigure(const PipelineConfig& config, bool reset_filter) {
   pipeline_.set_config(config);
+  view_ = ViewGeometry(config);
+  frames_since_full_ = 0;
   if (reset_filter) {
     filter_ = TemporalFilter(config.filter);
+    prediction_errors_.reset();
     had_fix_ = false;
   }
 }
@@ -43,8 +49,23 @@ const Localization& Localizer::localize(const ImageView& image, const FrameInfo&
   // 1. The frame on its own.
   const PipelineConfig& config = pipeline_.config();
   const bool filter = config.filter.enabled;
-  pipeline_.process(image, config.positioning.mode, result_.get(),
-                    readout_motion(frame.timestamp_ns));
+  const CameraMotion motion = readout_motion(frame.timestamp_ns);
+  FullSweepReason sweep = plan_sweep(frame.timestamp_ns);
+  out_.swept_px = 0;
+  if (sweep == FullSweepReason::kNone) {
+    pipeline_.process(image, config.positioning.mode, result_.get(), motion, plan_.span());
+    out_.swept_px = result_->swept_px;
+    if (!tracked_sweep_held()) sweep = FullSweepReason::kTrackFailed;
+  }
+  if (sweep != FullSweepReason::kNone) {
+    pipeline_.process(image, config.positioning.mode, result_.get(), motion);
+    out_.swept_px += result_->swept_px;
+    frames_since_full_ = 0;
+  } else {
+    ++frames_since_full_;
+  }
+  ++sweeps_.by_reason[static_cast<size_t>(sweep)];
+  out_.sweep = sweep;
   out_.frame = frame;
   out_.measured = result_->estimate;
   out_.markers_decoded = result_->marker_count;
@@ -87,6 +108,12 @@ const Localization& Localizer::localize(const ImageView& image, const FrameInfo&
         out_.published.valid ? FixState::kCoasting : (had_fix_ ? FixState::kLost : FixState::kNone);
   }
   refusals_.count(out_.refusal);
+  last_measured_ = out_.measured.valid;
+  if (has_prediction_ && out_.measured.valid) {
+    prediction_errors_.add(std::hypot(out_.measured.pose.x_m - predicted_.x[0],
+                                      out_.measured.pose.y_m - predicted_.x[1]),
+                           wrap_angle_rad(out_.measured.pose.yaw_rad - predicted_.x[2]));
+  }
   out_.localize_ns = monotonic_ns() - start_ns;
   return out_;
 }
@@ -112,6 +139,26 @@ CameraMotion Localizer::readout_motion(int64_t t_ns) const {
       std::sqrt(std::max(s.p[3 * N + 3], s.p[4 * N + 4])) + sigma_w * std::hypot(rx, ry);
   m.sigma_yaw_rate_radps = sigma_w;
   return m;
+}
+
+FullSweepReason Localizer::plan_sweep(int64_t t_ns) {
+  const PipelineConfig& c = pipeline_.config();
+  has_prediction_ = c.filter.enabled && last_measured_ &&
+                    predict_motion(filter_.motion(), t_ns, &predicted_) == PredictOutcome::kOk;
+  if (!has_prediction_) prediction_errors_.reset();
+  if (!c.detector.tracking || !c.filter.enabled) return FullSweepReason::kOff;
+  if (!has_prediction_) return FullSweepReason::kNoFix;
+  if (frames_since_full_ + 1 >= c.detector.full_sweep_every) return FullSweepReason::kScheduled;
+  return plan_tracking(view_, c.detector, predicted_, prediction_errors_, &plan_);
+}
+
+// A tracked sweep stands only when it decoded every marker the plan put
+// wholly inside the frame, cut no coloured blob at a window edge, was not
+// abandoned as noise and gave a pose: otherwise the whole frame decides.
+bool Localizer::tracked_sweep_held() const {
+  const FrameResult& r = *result_;
+  return r.estimate.valid && !r.noisy && r.window_cuts == 0 &&
+         r.marker_count >= plan_.expected_whole;
 }
 
 }  // namespace ceilpose

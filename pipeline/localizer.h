@@ -9,12 +9,24 @@
 #include <memory>
 
 #include "core/refusal.h"
+#include "core/view_geometry.h"
 #include "pipeline/localization.h"
 #include "pipeline/pipeline.h"
 #include "pipeline/pipeline_config.h"
 #include "pipeline/temporal_filter.h"
 
 namespace ceilpose {
+
+// Frames swept by windows (tracked) and whole, by reason (FullSweepReason).
+struct SweepCounts {
+  std::array<uint64_t, 7> by_reason{};  // index: FullSweepReason
+  uint64_t tracked() const { return by_reason[0]; }
+  uint64_t full() const {
+    uint64_t n = 0;
+    for (size_t k = 1; k < by_reason.size(); ++k) n += by_reason[k];
+    return n;
+  }
+};
 
 // `config` with the positioning mode and the filter switch set, as `locate
 // --mode --filter` and the tests choose them.
@@ -37,6 +49,7 @@ class Localizer {
   const PipelineConfig& config() const { return pipeline_.config(); }
   const RefusalHistogram& refusals() const { return refusals_; }
   const FilterStats& filter_stats() const { return filter_.stats(); }
+  const SweepCounts& sweeps() const { return sweeps_; }
   // The last frame's detection in detail (markers, rejects), for diagnostics.
   const FrameResult& last_frame() const { return *result_; }
   const Pipeline& pipeline() const { return pipeline_; }
@@ -44,6 +57,14 @@ class Localizer {
  private:
   Pipeline pipeline_;
   TemporalFilter filter_;
+  ViewGeometry view_;  // for the tracking windows
+  TrackingPlan plan_;
+  MotionState predicted_;        // the filter's state carried to this frame's time
+  bool has_prediction_ = false;  // ... when there was one
+  PredictionErrors prediction_errors_;
+  int frames_since_full_ = 0;
+  bool last_measured_ = false;  // the previous frame gave a measurement
+  SweepCounts sweeps_;
   std::unique_ptr<FrameResult> result_;  // ~50 kB: on the heap, allocated once
   Localization out_;
   bool had_fix_ = false;
@@ -53,6 +74,10 @@ class Localizer {
   // for a rolling shutter's readout; invalid when there is no filter, no
   // state within the prediction horizon or no readout.
   CameraMotion readout_motion(int64_t t_ns) const;
+  // Windows for the frame at t_ns (plan_), or why to sweep it whole.
+  FullSweepReason plan_sweep(int64_t t_ns);
+  // Whether a tracked sweep found what the plan expected.
+  bool tracked_sweep_held() const;
 };
 
 }  // namespace ceilpose

@@ -154,7 +154,7 @@ Refusal Pipeline::refusal_without_markers(const FrameResult& result, size_t pair
 }
 
 void Pipeline::process(const ImageView& frame, PositioningMode mode, FrameResult* out,
-                       const CameraMotion& motion) {
+                       const CameraMotion& motion, std::span<const PixelWindow> windows) {
   const int64_t start_ns = monotonic_ns();
   int64_t stamp_ns = start_ns;
   auto lap = [&](int stage) {
@@ -166,6 +166,8 @@ void Pipeline::process(const ImageView& frame, PositioningMode mode, FrameResult
   out->marker_count = 0;
   out->rejects = MarkerRejects{};
   out->noisy = false;
+  out->window_cuts = 0;
+  out->swept_px = 0;
   out->unit_gains = false;
   out->stage_ns.fill(0);
   out->reconcile = ReconcileCounts{};
@@ -185,7 +187,14 @@ void Pipeline::process(const ImageView& frame, PositioningMode mode, FrameResult
 
   // 1. Classify every pixel (adaptive fused lookup) and build components.
   out->unit_gains = !classifier_.adapt(frame);
-  out->noisy = !labeler_.label(frame, classifier_);
+  out->noisy = windows.empty() ? !labeler_.label(frame, classifier_)
+                               : !labeler_.label(frame, classifier_, windows);
+  out->window_cuts = labeler_.window_cut_count();
+  out->swept_px = int64_t{frame.width} * frame.height;
+  if (!windows.empty()) {
+    out->swept_px = 0;
+    for (const PixelWindow& w : windows) out->swept_px += w.area_px();
+  }
   lap(kStageComponents);
 
   // 2. Rectangle template fit.

@@ -74,6 +74,8 @@ struct FrameResult {
   std::array<MarkerObservation, kMaxMarkersPerFrame> markers{};
   MarkerRejects rejects;
   bool noisy = false;       // the labeler abandoned the frame (run budget exceeded)
+  int window_cuts = 0;      // tracked: coloured blobs cut by a window edge (ComponentLabeler)
+  int64_t swept_px = 0;     // pixels the labeler classified (the windows', or the frame's)
   bool unit_gains = false;  // no tile to take the colour reference from
   std::array<int64_t, kStageCount> stage_ns{};  // duration of each stage
   int64_t total_ns = 0;
@@ -92,8 +94,10 @@ class Pipeline {
   // (refusal unusable_frame) and no markers.
   // `motion`: the camera's motion during the readout when known from
   // elsewhere (rolling shutter; see Positioner::solve).
+  // `windows` (a tracked sweep, marker_tracking.h): label only there, merged
+  // and inside the frame; empty: the whole frame.
   void process(const ImageView& frame, PositioningMode mode, FrameResult* out,
-               const CameraMotion& motion = {});
+               const CameraMotion& motion = {}, std::span<const PixelWindow> windows = {});
 
   // Replaces the configuration (SIGHUP reload of thresholds); rebuilds the
   // colour table and re-allocates only if the image size changed. Not in the

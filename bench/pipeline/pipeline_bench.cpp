@@ -17,11 +17,14 @@
 #include <cmath>
 #include <cstdio>
 #include <map>
+#include <memory>
 #include <random>
+#include <tuple>
 #include <vector>
 
 #include "core/clock.h"
 #include "pipeline/localizer.h"
+#include "sim/camera_format.h"
 #include "sim/renderer.h"
 #include "sim/scenarios.h"
 #include "sim/visibility.h"
@@ -137,6 +140,91 @@ void BM_Pipeline(benchmark::State& state) {
   state.counters["valid"] = valid / n;
 }
 
+// The `drive` set (a moving sequence: curves, speed changes), 120 frames at
+// 30 fps, as the camera hands them over: RGB24 or YUYV 4:2:2.
+constexpr int kDriveFrames = 120;
+const std::vector<Image>& drive_frames(int width_px, PixelFormat format) {
+  static std::map<std::pair<int, PixelFormat>, std::vector<Image>> cache;
+  auto& frames = cache[{width_px, format}];
+  if (!frames.empty()) return frames;
+  const sim::SceneOptions options = options_for(width_px);
+  sim::Renderer renderer(options);
+  const Result<sim::Scenario> scenario = sim::make_scenario("drive", options, kDriveFrames, 3);
+  if (!scenario) {
+    std::fprintf(stderr, "pipeline_bench: %s\n", scenario.error().message.c_str());
+    return frames;
+  }
+  Image rgb;
+  for (const sim::ScenarioFrame& f : scenario->frames) {
+    renderer.render(f.pose, f.mount, f.effects, f.seed, &rgb);
+    frames.push_back(format == PixelFormat::kRgb24 ? rgb : sim::convert_rgb(rgb, format));
+  }
+  return frames;
+}
+
+std::map<std::tuple<int, int, int>, double>& drive_median_ns() {
+  static std::map<std::tuple<int, int, int>, double> m;
+  return m;
+}
+
+// The daemon's path on a moving robot (filter on), each frame swept whole
+// (tracking off) or, with the fix, only in the predicted windows: thread CPU
+// time of Localizer::localize per frame, median over every frame of every
+// pass through the sequence (the filter restarts at each pass).
+void BM_Drive(benchmark::State& state) {
+  const int width_px = static_cast<int>(state.range(0));
+  const bool yuyv = state.range(1) != 0;
+  const bool tracking = state.range(2) != 0;
+  const std::vector<Image>& frames =
+      drive_frames(width_px, yuyv ? PixelFormat::kYuyv : PixelFormat::kRgb24);
+  if (frames.size() != kDriveFrames) {
+    state.SkipWithError("the drive set did not render");
+    return;
+  }
+  PipelineConfig config = config_for(width_px);
+  config.detector.tracking = tracking;
+  config = with_mode(config, PositioningMode::kAuto, true);
+  auto localizer = std::make_unique<Localizer>(config);
+  std::vector<double> frame_cpu_ns;
+  frame_cpu_ns.reserve(1 << 16);
+  std::array<std::vector<double>, kStageCount> stage_ns;
+  for (auto& v : stage_ns) v.reserve(1 << 16);
+  double tracked = 0.0, valid = 0.0, swept = 0.0;
+  size_t i = 0;
+  FrameInfo info;
+  for (auto _ : state) {
+    if (i % frames.size() == 0) {
+      state.PauseTiming();
+      localizer = std::make_unique<Localizer>(config);
+      info.timestamp_ns = 0;
+      state.ResumeTiming();
+    }
+    info.timestamp_ns += 33'333'333;
+    const int64_t cpu0_ns = clock_ns(CLOCK_THREAD_CPUTIME_ID);
+    const Localization& loc = localizer->localize(frames[i++ % frames.size()].view(), info);
+    const int64_t cpu_ns = clock_ns(CLOCK_THREAD_CPUTIME_ID) - cpu0_ns;
+    benchmark::DoNotOptimize(loc.published);
+    if (frame_cpu_ns.size() < frame_cpu_ns.capacity()) {
+      frame_cpu_ns.push_back(static_cast<double>(cpu_ns));
+      for (int s = 0; s < kStageCount; ++s)
+        stage_ns[s].push_back(static_cast<double>(loc.stage_ns[s]));
+    }
+    tracked += loc.tracked() ? 1.0 : 0.0;
+    valid += loc.published.valid ? 1.0 : 0.0;
+    swept += static_cast<double>(loc.swept_px) / (frames[0].width() * frames[0].height());
+  }
+  const double n = static_cast<double>(state.iterations());
+  const double med = median(frame_cpu_ns);
+  state.counters["swept_share"] = swept / n;
+  drive_median_ns()[{width_px, yuyv ? 1 : 0, tracking ? 1 : 0}] = med;
+  for (int s = 0; s < kStageCount; ++s) {
+    state.counters[std::string(Pipeline::stage_name(s)) + "_us"] = median(stage_ns[s]) * 1e-3;
+  }
+  state.counters["median_cpu_us"] = med * 1e-3;
+  state.counters["tracked"] = tracked / n;
+  state.counters["valid"] = valid / n;
+}
+
 // Grey frames of the same size with tag36h11 tags laid out like the
 // markers (a 4 × 3 grid, each tag about as large as a marker, random
 // rotation), anti-aliased by 4 × 4 supersampling, read noise σ = 3.
@@ -239,6 +327,10 @@ BENCHMARK(BM_Pipeline)
     ->Args({1280, 0})
     ->Args({640, 25})
     ->Unit(benchmark::kMicrosecond);
+BENCHMARK(BM_Drive)
+    ->ArgsProduct({{320, 640, 1280}, {0, 1}, {0, 1}})
+    ->ArgNames({"width", "yuyv", "tracking"})
+    ->Unit(benchmark::kMicrosecond);
 BENCHMARK(BM_AprilTag)
     ->ArgsProduct({{320, 640, 1280}, {2, 1}})
     ->ArgNames({"width", "decimate"})
@@ -259,6 +351,21 @@ void print_summary() {
       }
     }
     std::printf("\n");
+  }
+  if (drive_median_ns().empty()) return;
+  std::printf("\ndrive set, filter on (medians of thread CPU time per frame, ms; x AprilTag d2)\n");
+  std::printf("%-10s %-6s %16s %16s %8s\n", "size", "pixels", "full sweeps", "tracked", "ratio");
+  for (int width_px : {320, 640, 1280}) {
+    for (int yuyv : {0, 1}) {
+      const auto full = drive_median_ns().find({width_px, yuyv, 0});
+      const auto tracked = drive_median_ns().find({width_px, yuyv, 1});
+      if (full == drive_median_ns().end() || tracked == drive_median_ns().end()) continue;
+      const auto tag = apriltag_median_ns().find({width_px, 2});
+      const double tag_ns = tag == apriltag_median_ns().end() ? 0.0 : tag->second;
+      std::printf("%4dx%-5d %-6s %7.3f (%5.1fx) %7.3f (%5.1fx) %8.2f\n", width_px, width_px * 3 / 4,
+                  yuyv ? "YUYV" : "RGB", full->second * 1e-6, tag_ns / full->second,
+                  tracked->second * 1e-6, tag_ns / tracked->second, tracked->second / full->second);
+    }
   }
 }
 

@@ -9,6 +9,7 @@
 #include "core/camera_model.h"
 #include "core/ceiling_layout.h"
 #include "core/image.h"
+#include "sim/camera_format.h"
 
 namespace ceilpose::test {
 
@@ -33,9 +34,7 @@ Image render_markers(int width_px, int height_px, std::span<const CraftedMarker>
                      const CeilingLayout& layout = {}, const Lighting& lighting = {},
                      double px_per_m = kDefaultPxPerM);
 
-// The same pixels as BGR24, YUYV (BT.601 limited range, chroma averaged over
-// each pixel pair) or GRAY8.
-Image convert_rgb(const Image& rgb, PixelFormat format);
+using sim::convert_rgb;
 
 // RGB24 image box-blurred over `length_px` pixels along rows (North at
 // yaw 0), edges clamped.

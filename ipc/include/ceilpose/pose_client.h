@@ -115,14 +115,18 @@ typedef struct ceilpose_status {
   uint32_t latency_p99_us;
   uint32_t latency_max_us;
   uint32_t fix_state; /* enum ceilpose_fix_state */
-  uint32_t reserved0;
+  /* Frames swept only where the filter predicted the markers (tracking),
+   * since the daemon started, modulo 2^32; 0 from daemons before it. */
+  uint32_t tracked_frames;
   int64_t updated_mono_ns;                /* when the daemon filled this record */
   char source[CEILPOSE_SOURCE_TEXT_SIZE]; /* NUL-terminated, e.g. "v4l2:/dev/video0" */
   /* Frames per refusal reason since the daemon started: refusals[i] counts
    * the reason ceilpose_refusal_name(i) ("none": frames that gave a pose);
    * the first refusal_count slots are used. */
   uint32_t refusal_count;
-  uint32_t reserved1;
+  /* Frames swept whole (no fix, scheduled, or a failed track swept again),
+   * since the daemon started, modulo 2^32; 0 from daemons before it. */
+  uint32_t full_sweep_frames;
   uint64_t refusals[CEILPOSE_REFUSAL_SLOTS];
 } ceilpose_status;
 

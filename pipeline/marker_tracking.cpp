@@ -1,0 +1,136 @@
+#include "pipeline/marker_tracking.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include "core/camera_model.h"
+
+namespace ceilpose {
+
+const char* to_string(FullSweepReason reason) {
+  switch (reason) {
+    case FullSweepReason::kNone:
+      return "tracked";
+    case FullSweepReason::kOff:
+      return "off";
+    case FullSweepReason::kNoFix:
+      return "no_fix";
+    case FullSweepReason::kScheduled:
+      return "scheduled";
+    case FullSweepReason::kUncertain:
+      return "uncertain";
+    case FullSweepReason::kTooMany:
+      return "too_many";
+    case FullSweepReason::kTrackFailed:
+      return "track_failed";
+  }
+  return "unknown";
+}
+
+void PredictionErrors::add(double position_m, double yaw_rad) {
+  if (++samples_ <= kSkipped) return;
+  const int slot = (samples_ - kSkipped - 1) % kRemembered;
+  position_m_[slot] = std::abs(position_m);
+  yaw_rad_[slot] = std::abs(yaw_rad);
+}
+
+double PredictionErrors::max_position_m() const {
+  return *std::max_element(position_m_.begin(), position_m_.end());
+}
+
+double PredictionErrors::max_yaw_rad() const {
+  return *std::max_element(yaw_rad_.begin(), yaw_rad_.end());
+}
+
+FullSweepReason plan_tracking(const ViewGeometry& view, const DetectorParams& params,
+                              const MotionState& s, const PredictionErrors& errors,
+                              TrackingPlan* plan) {
+  const CameraIntrinsics& k = view.intrinsics();
+  const CeilingLayout& layout = view.layout();
+  const Pose2D robot{s.x[0], s.x[1], s.x[2]};
+  const CameraPose camera = camera_pose_from_robot(robot, view.mount());
+  const double px_per_m = std::max(k.fx, k.fy) / view.depth_m();
+  // The margin: a fixed part (blur, edge quantisation, the model's own
+  // error), the recent predictions' largest errors in position and, at the
+  // frame's corners, in yaw, and how far the view moves during the readout
+  // (the prediction is the centre row's).
+  const double error_m = errors.max_position_m();
+  const double error_rad = errors.max_yaw_rad();
+  const double half_diagonal_px = 0.5 * std::hypot(k.width, k.height);
+  // The view's motion during half the readout, pixels: translation, and
+  // the yaw's rotation at the frame's corners.
+  const double readout_px =
+      (std::hypot(s.x[3], s.x[4]) * px_per_m + std::abs(s.x[5]) * half_diagonal_px) * 0.5 *
+      std::max(0.0, k.readout_ms) * 1e-3;
+  const double margin_px =
+      params.track_margin_px +
+      params.track_margin_errors * (error_m * px_per_m + error_rad * half_diagonal_px) + readout_px;
+  plan->margin_px = margin_px;
+  plan->window_count = 0;
+  plan->expected_whole = 0;
+  if (!errors.known()) return FullSweepReason::kNoFix;
+  if (!std::isfinite(margin_px)) return FullSweepReason::kUncertain;
+
+  // Markers farther from the optical centre than the frame's half diagonal
+  // on the ceiling, plus a marker and the margin, cannot be in view.
+  const double marker_radius_m = std::hypot(layout.rect_width_m, 0.5 * layout.rect_height_m);
+  const double reach_m = (half_diagonal_px + margin_px) / px_per_m + marker_radius_m;
+  const double tilt_reach_m =
+      view.depth_m() * std::tan(std::hypot(view.mount().tilt_x_rad, view.mount().tilt_y_rad));
+  const double reach2_m2 = (reach_m + tilt_reach_m) * (reach_m + tilt_reach_m);
+  const CeilingMap& map = view.map();
+  const int codes = map.codes();
+  int64_t area_px = 0;
+  for (int j = 0; j < codes; ++j) {
+    for (int i = 0; i < codes; ++i) {
+      const MarkerPlacement* p = map.find(i, j);
+      if (p == nullptr) continue;
+      const double dx = p->x_m - camera.t_w[0], dy = p->y_m - camera.t_w[1];
+      if (dx * dx + dy * dy > reach2_m2) continue;
+      double u_min = INFINITY, u_max = -INFINITY, v_min = INFINITY, v_max = -INFINITY;
+      bool projected = true;
+      for (double se : {-1.0, 1.0}) {
+        for (double sn : {-1.0, 1.0}) {
+          double x_m = 0.0, y_m = 0.0, u = 0.0, v = 0.0;
+          p->world_point(se * layout.rect_width_m, sn * 0.5 * layout.rect_height_m, &x_m, &y_m);
+          projected =
+              projected && project_world_point(k, camera, {x_m, y_m, layout.height_m}, &u, &v);
+          u_min = std::min(u_min, u), u_max = std::max(u_max, u);
+          v_min = std::min(v_min, v), v_max = std::max(v_max, v);
+        }
+      }
+      if (!projected || !std::isfinite(u_min + u_max + v_min + v_max)) {
+        return FullSweepReason::kUncertain;
+      }
+      const double x0 = u_min - margin_px, x1 = u_max + margin_px;
+      const double y0 = v_min - margin_px, y1 = v_max + margin_px;
+      // A marker cut by the frame's edge even if the prediction is off by
+      // the whole margin cannot be decoded (pipeline: kCut): no window.
+      const double w = k.width - 1.0, h = k.height - 1.0;
+      if (u_min + margin_px < 0.0 || v_min + margin_px < 0.0 || u_max - margin_px > w ||
+          v_max - margin_px > h) {
+        continue;
+      }
+      if (plan->window_count == kMaxMarkersPerFrame) return FullSweepReason::kTooMany;
+      PixelWindow& win = plan->windows[plan->window_count++];
+      win.x0 = static_cast<int>(std::max(0.0, std::floor(x0)));
+      win.y0 = static_cast<int>(std::max(0.0, std::floor(y0)));
+      win.x1 = static_cast<int>(std::min(w, std::ceil(x1)));
+      win.y1 = static_cast<int>(std::min(h, std::ceil(y1)));
+      // Whole beyond doubt: inside the frame even if the prediction is off
+      // by the whole margin.
+      if (x0 >= 0.0 && y0 >= 0.0 && x1 <= w && y1 <= h) {
+        ++plan->expected_whole;
+      }
+    }
+  }
+  plan->window_count = merge_windows(plan->windows, plan->window_count);
+  for (const PixelWindow& w : plan->span()) area_px += w.area_px();
+  if (static_cast<double>(area_px) >
+      params.track_max_area_share * static_cast<double>(k.width) * k.height) {
+    return FullSweepReason::kUncertain;
+  }
+  return FullSweepReason::kNone;
+}
+
+}  // namespace ceilpose

@@ -1,0 +1,12 @@
+#pragma once
+// A rendered RGB frame as a camera hands it over: BGR24, YUYV 4:2:2 (BT.601
+// limited range, V4L2's default quantisation for USB cameras; the chroma of
+// each pixel pair averaged, as an ISP subsamples it) or GRAY8. The detector
+// reads each natively; accuracy and speed are measured on them.
+#include "core/image.h"
+
+namespace ceilpose::sim {
+
+Image convert_rgb(const Image& rgb, PixelFormat format);
+
+}  // namespace ceilpose::sim
