@@ -31,6 +31,30 @@ int64_t sum_squares_to(int64_t k) { return k * (k + 1) * (2 * k + 1) / 6; }
 
 }  // namespace
 
+bool PixelWindow::row_span(int y, int* lo, int* hi) const {
+  if (y < y0 || y > y1) return false;
+  if (!quad) {
+    *lo = x0, *hi = x1;
+    return true;
+  }
+  // Where the row's centre line crosses the quadrilateral's edges.
+  float u_min = 1e30f, u_max = -1e30f;
+  const float v = static_cast<float>(y);
+  for (int k = 0; k < 4; ++k) {
+    const float ua = qu[k], va = qv[k], ub = qu[(k + 1) % 4], vb = qv[(k + 1) % 4];
+    if ((v < va && v < vb) || (v > va && v > vb)) continue;
+    const float u = vb == va ? std::min(ua, ub) : ua + (v - va) * (ub - ua) / (vb - va);
+    const float u_other = vb == va ? std::max(ua, ub) : u;
+    u_min = std::min(u_min, u);
+    u_max = std::max(u_max, u_other);
+  }
+  if (u_max < u_min) return false;
+  // Whole pixels whose centres may lie inside, one more each side.
+  *lo = std::max(x0, static_cast<int>(std::floor(u_min)) - 1);
+  *hi = std::min(x1, static_cast<int>(std::ceil(u_max)) + 1);
+  return *lo <= *hi;
+}
+
 double Component::orientation_rad() const { return 0.5 * std::atan2(2.0 * mu11, mu20 - mu02); }
 
 ComponentLabeler::ComponentLabeler(int width_px, int height_px, const DetectorParams& params)
@@ -44,11 +68,13 @@ void ComponentLabeler::resize(int width_px, int height_px) {
   const double pixels = static_cast<double>(width_) * height_;
   max_runs_ = std::max(1024, static_cast<int>(pixels * params_.max_runs_per_pixel));
   row_class_.assign(static_cast<size_t>(width_) + kRowPadding, 0);
+  row_edge_.assign(static_cast<size_t>(width_) + kRowPadding, 0);
   runs_.resize(static_cast<size_t>(max_runs_) + 1);
   parent_.resize(runs_.size());
   label_.resize(runs_.size());
   comps_.resize(runs_.size());
   sums_.resize(runs_.size());
+  window_edge_.resize(runs_.size());
   run_count_ = 0;
   comp_count_ = 0;
 }
@@ -70,25 +96,25 @@ void ComponentLabeler::classify_span(const ImageView& frame, int y, int x0, int 
       return;
     }
     case PixelFormat::kYuyv: {
-      // Y0 U Y1 V per pixel pair: a pair shares its chroma.
+      // Y0 U Y1 V per pixel pair: a pair shares its chroma, whose terms are
+      // computed once. yuv_to_rgb's arithmetic, in ints held in registers
+      // (through its pointers the compiler kept them in memory: 2.2x RGB).
       const uint32_t* tr = classifier.table(0);
       const uint32_t* tg = classifier.table(1);
       const uint32_t* tb = classifier.table(2);
-      uint8_t r = 0, g = 0, b = 0;
-      auto one = [&](int x) {
-        const uint8_t* q = row + 4 * (x / 2);
-        yuv_to_rgb(q[(x & 1) * 2], q[1], q[3], &r, &g, &b);
-        out[x] = lut[tr[r] | tg[g] | tb[b]];
+      auto level = [](int v) { return std::clamp(v >> 8, 0, 255); };
+      auto classify = [&](int luma, int rc, int gc, int bc) {
+        const int c = 298 * (luma - 16) + 128;
+        return lut[tr[level(c + rc)] | tg[level(c + gc)] | tb[level(c + bc)]];
       };
       int x = x0;
-      if ((x & 1) != 0) one(x++);
-      for (const uint8_t* q = row + 2 * x; x + 1 <= x1; x += 2, q += 4) {
-        yuv_to_rgb(q[0], q[1], q[3], &r, &g, &b);
-        out[x] = lut[tr[r] | tg[g] | tb[b]];
-        yuv_to_rgb(q[2], q[1], q[3], &r, &g, &b);
-        out[x + 1] = lut[tr[r] | tg[g] | tb[b]];
+      const uint8_t* q = row + 4 * (x / 2);
+      for (; x <= x1; q += 4) {
+        const int d = q[1] - 128, e = q[3] - 128;
+        const int rc = 409 * e, gc = -100 * d - 208 * e, bc = 516 * d;
+        if ((x & 1) == 0) out[x++] = classify(q[0], rc, gc, bc);
+        if (x <= x1) out[x++] = classify(q[2], rc, gc, bc);
       }
-      if (x <= x1) one(x);
       return;
     }
     case PixelFormat::kGray8:
@@ -125,7 +151,7 @@ bool ComponentLabeler::encode_row(int y, int x0, int x1) {
       // right after a coloured run.
       if (in_row > 0 && runs_[run_count_ - 1].x1 + 1 == run_x0) {
         if (run_count_ >= run_budget_) return false;
-        runs_[run_count_++] = Run{run_x0, run_x1, y, 0, PixelClass::kDark};
+        runs_[run_count_++] = Run{run_x0, run_x1, y, 0, PixelClass::kDark, false};
       }
       continue;
     }
@@ -136,11 +162,17 @@ bool ComponentLabeler::encode_row(int y, int x0, int x1) {
       if (dark.x1 + 1 == run_x0 && static_cast<uint8_t>(left.cls) == cls) {
         left.dark_px += dark.x1 - dark.x0 + 1;
         left.x1 = run_x1;
+        left.window_edge = left.window_edge || row_edge_[dark.x0] != 0 || row_edge_[run_x1] != 0;
         continue;
       }
     }
     if (run_count_ >= run_budget_) return false;
-    runs_[run_count_] = Run{run_x0, run_x1, y, 0, static_cast<PixelClass>(cls)};
+    runs_[run_count_] = Run{run_x0,
+                            run_x1,
+                            y,
+                            0,
+                            static_cast<PixelClass>(cls),
+                            row_edge_[run_x0] != 0 || row_edge_[run_x1] != 0};
     parent_[run_count_] = run_count_;
     ++run_count_;
   }
@@ -177,7 +209,7 @@ void ComponentLabeler::join_rows(int prev_begin, int prev_end, int cur_begin, in
   }
 }
 
-void ComponentLabeler::accumulate(std::span<const PixelWindow> windows) {
+void ComponentLabeler::accumulate() {
   comp_count_ = 0;
   for (int i = 0; i < run_count_; ++i) {
     const Run& run = runs_[i];
@@ -192,6 +224,7 @@ void ComponentLabeler::accumulate(std::span<const PixelWindow> windows) {
       c.x_max = run.x1;
       c.y_min = c.y_max = run.y;
       sums_[k] = {};
+      window_edge_[k] = 0;
     } else {
       k = label_[root];
     }
@@ -209,6 +242,7 @@ void ComponentLabeler::accumulate(std::span<const PixelWindow> windows) {
     s[4] += y * y * static_cast<double>(n);
     c.area_px += static_cast<int>(n);
     c.dark_px += run.dark_px;
+    window_edge_[k] = static_cast<uint8_t>(window_edge_[k] | (run.window_edge ? 1 : 0));
     c.x_min = std::min(c.x_min, run.x0);
     c.x_max = std::max(c.x_max, run.x1);
     c.y_min = std::min(c.y_min, run.y);
@@ -223,18 +257,12 @@ void ComponentLabeler::accumulate(std::span<const PixelWindow> windows) {
     c.mu20 = s[2] / a - c.cx * c.cx;
     c.mu11 = s[3] / a - c.cx * c.cy;
     c.mu02 = s[4] / a - c.cy * c.cy;
-    // Its window's edges (the frame's for a full sweep): windows neither
-    // overlap nor touch, so the blob lies in exactly one.
-    for (const PixelWindow& w : windows) {
-      if (c.x_min < w.x0 || c.x_max > w.x1 || c.y_min < w.y0 || c.y_max > w.y1) continue;
-      c.touches_border = c.x_min == w.x0 || c.y_min == w.y0 || c.x_max == w.x1 || c.y_max == w.y1;
-      const bool inner_edge = (c.x_min == w.x0 && w.x0 > 0) || (c.y_min == w.y0 && w.y0 > 0) ||
-                              (c.x_max == w.x1 && w.x1 < width_ - 1) ||
-                              (c.y_max == w.y1 && w.y1 < height_ - 1);
-      if (inner_edge && c.cls != PixelClass::kDark && 4 * c.area_px >= params_.min_rect_area_px) {
-        ++window_cuts_;
-      }
-      break;
+    const bool frame_edge =
+        c.x_min == 0 || c.y_min == 0 || c.x_max == width_ - 1 || c.y_max == height_ - 1;
+    c.touches_border = frame_edge || window_edge_[k] != 0;
+    if (window_edge_[k] != 0 && c.cls != PixelClass::kDark &&
+        4 * c.area_px >= params_.min_rect_area_px) {
+      ++window_cuts_;
     }
   }
 }
@@ -266,6 +294,7 @@ bool ComponentLabeler::sweep_rows(const ImageView& frame, const ColorClassifier&
   run_count_ = 0;
   comp_count_ = 0;
   window_cuts_ = 0;
+  swept_px_ = 0;
   if (frame.width != width_ || frame.height != height_ || frame.empty()) return false;
   // Grey frames carry no colour: nothing can be red or green.
   if (frame.format == PixelFormat::kGray8 || frame.format == PixelFormat::kMjpeg) return true;
@@ -274,20 +303,42 @@ bool ComponentLabeler::sweep_rows(const ImageView& frame, const ColorClassifier&
     y_begin = std::min(y_begin, w.y0);
     y_end = std::max(y_end, w.y1);
   }
+  // A run that starts or ends on a window's edge may continue beyond it
+  // (the frame's own edges are accumulate()'s): row_edge_ marks those
+  // pixels, and the whole span on a window's first and last row.
+  bool marked = false;
+  auto mark_edge = [&](int x) {
+    if (x > 0 && x < width_ - 1) row_edge_[x] = 1, marked = true;
+  };
   int prev_begin = 0, prev_end = 0;
   for (int y = y_begin; y <= y_end; ++y) {
     int lo = width_, hi = -1;
     for (const PixelWindow& w : windows) {
-      if (y < w.y0 || y > w.y1) continue;
-      classify_span(frame, y, w.x0, w.x1, classifier);
-      lo = std::min(lo, w.x0);
-      hi = std::max(hi, w.x1);
+      int x0 = 0, x1 = 0;
+      if (!w.row_span(y, &x0, &x1)) continue;
+      classify_span(frame, y, x0, x1, classifier);
+      swept_px_ += x1 - x0 + 1;
+      // A quadrilateral's first and last rows are its box's (plan_tracking
+      // makes the box from it); a blob at its pointed ends also meets its
+      // slanted sides, which mark_edge marks.
+      const bool cap = (y == w.y0 && y > 0) || (y == w.y1 && y < height_ - 1);
+      if (cap) {
+        std::memset(row_edge_.data() + x0, 1, static_cast<size_t>(x1 - x0 + 1));
+        marked = true;
+      } else {
+        mark_edge(x0);
+        mark_edge(x1);
+      }
+      lo = std::min(lo, x0);
+      hi = std::max(hi, x1);
     }
     const int cur_begin = run_count_;
     if (hi >= lo) {
       const bool ok = encode_row(y, lo, hi);
-      // Outside the spans the buffer stays zero (encode_row relies on it).
+      // Outside the spans the buffers stay zero (encode_row relies on it).
       std::memset(row_class_.data() + lo, 0, static_cast<size_t>(hi - lo + 1));
+      if (marked) std::memset(row_edge_.data() + lo, 0, static_cast<size_t>(hi - lo + 1));
+      marked = false;
       if (!ok) {
         run_count_ = 0;
         return false;
@@ -297,7 +348,7 @@ bool ComponentLabeler::sweep_rows(const ImageView& frame, const ColorClassifier&
     prev_begin = cur_begin;
     prev_end = run_count_;
   }
-  accumulate(windows);
+  accumulate();
   return true;
 }
 
@@ -315,8 +366,8 @@ int merge_windows(std::span<PixelWindow> windows, int count) {
         if (!touch(windows[i], windows[j])) continue;
         PixelWindow& a = windows[i];
         const PixelWindow& b = windows[j];
-        a = {std::min(a.x0, b.x0), std::min(a.y0, b.y0), std::max(a.x1, b.x1),
-             std::max(a.y1, b.y1)};
+        a = PixelWindow{std::min(a.x0, b.x0), std::min(a.y0, b.y0), std::max(a.x1, b.x1),
+                        std::max(a.y1, b.y1)};  // a box: the quadrilaterals are dropped
         windows[j] = windows[--count];
         merged = true;
         break;

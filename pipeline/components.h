@@ -17,11 +17,17 @@
 
 namespace ceilpose {
 
-// A rectangle of the frame to sweep, pixels, inclusive bounds.
+// A part of the frame to sweep: a box, pixels, inclusive bounds, and within
+// it, when `quad` is set, only the convex quadrilateral (corners in order,
+// pixel coordinates): a marker seen at 45° fills half its box.
 struct PixelWindow {
   int x0 = 0, y0 = 0, x1 = -1, y1 = -1;
+  bool quad = false;
+  std::array<float, 4> qu{}, qv{};
   bool empty() const { return x1 < x0 || y1 < y0; }
   int64_t area_px() const { return empty() ? 0 : int64_t{x1 - x0 + 1} * (y1 - y0 + 1); }
+  // Row y's pixels inside the window, [*lo, *hi]; false when none.
+  bool row_span(int y, int* lo, int* hi) const;
   bool operator==(const PixelWindow&) const = default;
 };
 
@@ -60,11 +66,14 @@ class ComponentLabeler {
   // The same, within `windows` only (a tracked sweep): they must lie inside
   // the frame and not overlap (merge_windows); the run budget is that of
   // the windows' pixels. A component on a window's edge touches_border.
+  // The hot path of tracking: no allocation.
   bool label(const ImageView& frame, const ColorClassifier& classifier,
              std::span<const PixelWindow> windows);
 
   std::span<const Component> components() const { return {comps_.data(), comp_count_}; }
   int run_count() const { return run_count_; }
+  // Pixels the last sweep classified.
+  int64_t swept_px() const { return swept_px_; }
   // Red or green blobs of a tracked sweep on a window edge inside the frame
   // (a marker where the windows did not expect it); 0 for a full sweep.
   int window_cut_count() const { return window_cuts_; }
@@ -74,6 +83,7 @@ class ComponentLabeler {
     int32_t x0, x1, y;
     int32_t dark_px;
     PixelClass cls;
+    bool window_edge;  // starts or ends on a window's edge inside the frame
   };
 
   void classify_span(const ImageView& frame, int y, int x0, int x1,
@@ -84,7 +94,7 @@ class ComponentLabeler {
   void join_rows(int prev_begin, int prev_end, int cur_begin, int cur_end);
   int32_t find(int32_t i);
   void unite(int32_t a, int32_t b);
-  void accumulate(std::span<const PixelWindow> windows);
+  void accumulate();
 
   DetectorParams params_;
   int width_ = 0;
@@ -92,14 +102,17 @@ class ComponentLabeler {
   int max_runs_ = 0;
   int run_budget_ = 0;              // this sweep's: max_runs_, or the windows' share
   std::vector<uint8_t> row_class_;  // width + 8 bytes of padding
+  std::vector<uint8_t> row_edge_;   // 1: a window's edge inside the frame (tracked sweeps)
   std::vector<Run> runs_;
   std::vector<int32_t> parent_;
   std::vector<int32_t> label_;
   std::vector<Component> comps_;
   std::vector<std::array<double, 5>> sums_;  // Σx, Σy, Σx², Σxy, Σy² per component
+  std::vector<uint8_t> window_edge_;         // per component: some run on a window's edge
   int run_count_ = 0;
   size_t comp_count_ = 0;
   int window_cuts_ = 0;
+  int64_t swept_px_ = 0;
 };
 
 // Merges windows that overlap or touch into their bounding boxes, in place;

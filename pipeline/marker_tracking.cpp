@@ -87,18 +87,21 @@ FullSweepReason plan_tracking(const ViewGeometry& view, const DetectorParams& pa
       if (p == nullptr) continue;
       const double dx = p->x_m - camera.t_w[0], dy = p->y_m - camera.t_w[1];
       if (dx * dx + dy * dy > reach2_m2) continue;
-      double u_min = INFINITY, u_max = -INFINITY, v_min = INFINITY, v_max = -INFINITY;
+      // The outline's corners, in order around it.
+      constexpr double kCornerE[4] = {-1.0, 1.0, 1.0, -1.0}, kCornerN[4] = {-1.0, -1.0, 1.0, 1.0};
+      std::array<double, 4> cu{}, cv{};
       bool projected = true;
-      for (double se : {-1.0, 1.0}) {
-        for (double sn : {-1.0, 1.0}) {
-          double x_m = 0.0, y_m = 0.0, u = 0.0, v = 0.0;
-          p->world_point(se * layout.rect_width_m, sn * 0.5 * layout.rect_height_m, &x_m, &y_m);
-          projected =
-              projected && project_world_point(k, camera, {x_m, y_m, layout.height_m}, &u, &v);
-          u_min = std::min(u_min, u), u_max = std::max(u_max, u);
-          v_min = std::min(v_min, v), v_max = std::max(v_max, v);
-        }
+      for (int c = 0; c < 4; ++c) {
+        double x_m = 0.0, y_m = 0.0;
+        p->world_point(kCornerE[c] * layout.rect_width_m, kCornerN[c] * 0.5 * layout.rect_height_m,
+                       &x_m, &y_m);
+        projected = projected &&
+                    project_world_point(k, camera, {x_m, y_m, layout.height_m}, &cu[c], &cv[c]);
       }
+      const double u_min = *std::min_element(cu.begin(), cu.end());
+      const double u_max = *std::max_element(cu.begin(), cu.end());
+      const double v_min = *std::min_element(cv.begin(), cv.end());
+      const double v_max = *std::max_element(cv.begin(), cv.end());
       if (!projected || !std::isfinite(u_min + u_max + v_min + v_max)) {
         return FullSweepReason::kUncertain;
       }
@@ -117,6 +120,19 @@ FullSweepReason plan_tracking(const ViewGeometry& view, const DetectorParams& pa
       win.y0 = static_cast<int>(std::max(0.0, std::floor(y0)));
       win.x1 = static_cast<int>(std::min(w, std::ceil(x1)));
       win.y1 = static_cast<int>(std::min(h, std::ceil(y1)));
+      // The outline widened by the margin on every side: each corner moves
+      // out along both of its sides' directions.
+      const double eu = cu[1] - cu[0], ev = cv[1] - cv[0], nu = cu[3] - cu[0], nv = cv[3] - cv[0];
+      const double e_len = std::hypot(eu, ev), n_len = std::hypot(nu, nv);
+      if (e_len > 1.0 && n_len > 1.0) {
+        win.quad = true;
+        for (int c = 0; c < 4; ++c) {
+          win.qu[c] = static_cast<float>(
+              cu[c] + margin_px * (kCornerE[c] * eu / e_len + kCornerN[c] * nu / n_len));
+          win.qv[c] = static_cast<float>(
+              cv[c] + margin_px * (kCornerE[c] * ev / e_len + kCornerN[c] * nv / n_len));
+        }
+      }
       // Whole beyond doubt: inside the frame even if the prediction is off
       // by the whole margin.
       if (x0 >= 0.0 && y0 >= 0.0 && x1 <= w && y1 <= h) {
@@ -125,7 +141,7 @@ FullSweepReason plan_tracking(const ViewGeometry& view, const DetectorParams& pa
     }
   }
   plan->window_count = merge_windows(plan->windows, plan->window_count);
-  for (const PixelWindow& w : plan->span()) area_px += w.area_px();
+  for (const PixelWindow& w : plan->span()) area_px += w.area_px();  // boxes: an upper bound
   if (static_cast<double>(area_px) >
       params.track_max_area_share * static_cast<double>(k.width) * k.height) {
     return FullSweepReason::kUncertain;

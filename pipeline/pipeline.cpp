@@ -190,11 +190,7 @@ void Pipeline::process(const ImageView& frame, PositioningMode mode, FrameResult
   out->noisy = windows.empty() ? !labeler_.label(frame, classifier_)
                                : !labeler_.label(frame, classifier_, windows);
   out->window_cuts = labeler_.window_cut_count();
-  out->swept_px = int64_t{frame.width} * frame.height;
-  if (!windows.empty()) {
-    out->swept_px = 0;
-    for (const PixelWindow& w : windows) out->swept_px += w.area_px();
-  }
+  out->swept_px = labeler_.swept_px();
   lap(kStageComponents);
 
   // 2. Rectangle template fit.

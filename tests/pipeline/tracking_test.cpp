@@ -72,6 +72,34 @@ TEST_F(WindowLabelTest, WindowsAroundTheBlobsGiveTheFullSweepsComponentsExactly)
   EXPECT_EQ(labeler.window_cut_count(), 0);
 }
 
+// YUYV pairs share their chroma: windows starting and ending on odd columns
+// must classify as the whole-frame sweep does.
+TEST_F(WindowLabelTest, YuyvWindowsOnOddColumnsMatchTheFullSweep) {
+  const Image yuyv = test::convert_rgb(frame, PixelFormat::kYuyv);
+  ASSERT_TRUE(labeler.label(yuyv.view(), classifier));
+  const std::vector<Component> full(labeler.components().begin(), labeler.components().end());
+  ASSERT_EQ(full.size(), 2u);
+  const PixelWindow windows[] = {{5, 5, 41, 60}, {91, 55, 131, 110}};
+  ASSERT_TRUE(labeler.label(yuyv.view(), classifier, windows));
+  ASSERT_EQ(labeler.components().size(), 2u);
+  for (size_t k = 0; k < 2; ++k) {
+    EXPECT_EQ(labeler.components()[k].area_px, full[k].area_px);
+    EXPECT_DOUBLE_EQ(labeler.components()[k].cx, full[k].cx);
+    EXPECT_DOUBLE_EQ(labeler.components()[k].cy, full[k].cy);
+  }
+}
+
+// A window shaped to a marker seen at an angle: only its inside is swept,
+// and a blob reaching its slanted side is cut.
+TEST_F(WindowLabelTest, AQuadrilateralWindowSweepsItsInsideAndCutsAtItsSides) {
+  PixelWindow diamond{0, 0, 60, 70, true, {30.0f, 60.0f, 30.0f, 0.0f}, {0.0f, 35.0f, 70.0f, 35.0f}};
+  ASSERT_TRUE(labeler.label(frame.view(), classifier, std::span<const PixelWindow>(&diamond, 1)));
+  EXPECT_LT(labeler.swept_px(), diamond.area_px() * 6 / 10) << "half the box, and a pixel a side";
+  ASSERT_EQ(labeler.components().size(), 1u);  // the red blob, cut by the diamond's sides
+  EXPECT_TRUE(labeler.components()[0].touches_border);
+  EXPECT_EQ(labeler.window_cut_count(), 1);
+}
+
 TEST_F(WindowLabelTest, AWindowThatCutsABlobSaysSoAndNothingOutsideIsSeen) {
   const PixelWindow window[] = {{0, 0, 19, 60}};  // the red blob's right half is outside
   ASSERT_TRUE(labeler.label(frame.view(), classifier, window));
