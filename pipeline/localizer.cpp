@@ -31,11 +31,14 @@ Localizer::Localizer(const PipelineConfig& config)
     : pipeline_(config),
       filter_(config.filter),
       view_(config),
+      decoded_last_(static_cast<size_t>(view_.map().codes()) * view_.map().codes(), 0),
       result_(std::make_unique<FrameResult>()) {}
 
 void Localizer::reconfigure(const PipelineConfig& config, bool reset_filter) {
   pipeline_.set_config(config);
   view_ = ViewGeometry(config);
+  decoded_last_.assign(static_cast<size_t>(view_.map().codes()) * view_.map().codes(), 0);
+  last_decoded_count_ = 0;
   frames_since_full_ = 0;
   if (reset_filter) {
     filter_ = TemporalFilter(config.filter);
@@ -109,6 +112,7 @@ const Localization& Localizer::localize(const ImageView& image, const FrameInfo&
   }
   refusals_.count(out_.refusal);
   last_measured_ = out_.measured.valid;
+  remember_decoded();
   if (has_prediction_ && out_.measured.valid) {
     prediction_errors_.add(std::hypot(out_.measured.pose.x_m - predicted_.x[0],
                                       out_.measured.pose.y_m - predicted_.x[1]),
@@ -152,13 +156,39 @@ FullSweepReason Localizer::plan_sweep(int64_t t_ns) {
   return plan_tracking(view_, c.detector, predicted_, prediction_errors_, &plan_);
 }
 
-// A tracked sweep stands only when it decoded every marker the plan put
-// wholly inside the frame, cut no coloured blob at a window edge, was not
-// abandoned as noise and gave a pose: otherwise the whole frame decides.
+// A tracked sweep stands only when it decoded again every marker the last
+// frame decoded that the plan put wholly inside the frame (markers a whole
+// sweep cannot decode either, at a wide-angle lens's corners, are not
+// expected), cut no coloured blob at a window's side, was not abandoned as
+// noise and gave a pose: otherwise the whole frame decides.
 bool Localizer::tracked_sweep_held() const {
   const FrameResult& r = *result_;
-  return r.estimate.valid && !r.noisy && r.window_cuts == 0 &&
-         r.marker_count >= plan_.expected_whole;
+  if (!r.estimate.valid || r.noisy || r.window_cuts != 0) return false;
+  const int codes = view_.map().codes();
+  for (int w = 0; w < plan_.expected_whole; ++w) {
+    const int32_t index = plan_.whole[w];
+    if (decoded_last_[static_cast<size_t>(index)] == 0) continue;
+    bool found = false;
+    for (int m = 0; m < r.marker_count && !found; ++m)
+      found = r.markers[m].code_j * codes + r.markers[m].code_i == index;
+    if (!found) return false;
+  }
+  return true;
+}
+
+void Localizer::remember_decoded() {
+  for (int k = 0; k < last_decoded_count_; ++k)
+    decoded_last_[static_cast<size_t>(last_decoded_[k])] = 0;
+  last_decoded_count_ = 0;
+  const int codes = view_.map().codes();
+  for (int m = 0; m < result_->marker_count; ++m) {
+    const MarkerObservation& o = result_->markers[m];
+    if (o.code_i < 0 || o.code_j < 0 || o.code_i >= codes || o.code_j >= codes) continue;
+    const int32_t index = o.code_j * codes + o.code_i;
+    if (decoded_last_[static_cast<size_t>(index)] != 0) continue;
+    decoded_last_[static_cast<size_t>(index)] = 1;
+    last_decoded_[last_decoded_count_++] = index;
+  }
 }
 
 }  // namespace ceilpose

@@ -6,7 +6,9 @@
 // Not thread-safe: one instance, called in frame order from one thread;
 // refusals() may be read from any thread. localize() allocates nothing,
 // throws nothing and logs nothing.
+#include <array>
 #include <memory>
+#include <vector>
 
 #include "core/refusal.h"
 #include "core/view_geometry.h"
@@ -62,6 +64,12 @@ class Localizer {
   MotionState predicted_;        // the filter's state carried to this frame's time
   bool has_prediction_ = false;  // ... when there was one
   PredictionErrors prediction_errors_;
+  // Map indices (j * codes + i) of the markers the last frame decoded:
+  // decoded_last_[index] != 0, listed in last_decoded_.
+  std::vector<uint8_t> decoded_last_;
+  std::array<int32_t, kMaxMarkersPerFrame> last_decoded_{};
+  int last_decoded_count_ = 0;
+  void remember_decoded();
   int frames_since_full_ = 0;
   bool last_measured_ = false;  // the previous frame gave a measurement
   SweepCounts sweeps_;

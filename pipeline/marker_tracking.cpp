@@ -105,8 +105,24 @@ FullSweepReason plan_tracking(const ViewGeometry& view, const DetectorParams& pa
       if (!projected || !std::isfinite(u_min + u_max + v_min + v_max)) {
         return FullSweepReason::kUncertain;
       }
-      const double x0 = u_min - margin_px, x1 = u_max + margin_px;
-      const double y0 = v_min - margin_px, y1 = v_max + margin_px;
+      // Under lens distortion the outline's sides are curves: each window
+      // widens by how far its sides' midpoints bow from the straight chords.
+      double bow_px = 0.0;
+      if (k.has_distortion()) {
+        for (int c = 0; c < 4 && projected; ++c) {
+          const int d = (c + 1) % 4;
+          double x_m = 0.0, y_m = 0.0, u = 0.0, v = 0.0;
+          p->world_point(0.5 * (kCornerE[c] + kCornerE[d]) * layout.rect_width_m,
+                         0.25 * (kCornerN[c] + kCornerN[d]) * layout.rect_height_m, &x_m, &y_m);
+          projected = project_world_point(k, camera, {x_m, y_m, layout.height_m}, &u, &v);
+          bow_px =
+              std::max(bow_px, std::hypot(u - 0.5 * (cu[c] + cu[d]), v - 0.5 * (cv[c] + cv[d])));
+        }
+        if (!projected || !std::isfinite(bow_px)) return FullSweepReason::kUncertain;
+      }
+      const double grow_px = margin_px + bow_px;
+      const double x0 = u_min - grow_px, x1 = u_max + grow_px;
+      const double y0 = v_min - grow_px, y1 = v_max + grow_px;
       // A marker cut by the frame's edge even if the prediction is off by
       // the whole margin cannot be decoded (pipeline: kCut): no window.
       const double w = k.width - 1.0, h = k.height - 1.0;
@@ -128,15 +144,15 @@ FullSweepReason plan_tracking(const ViewGeometry& view, const DetectorParams& pa
         win.quad = true;
         for (int c = 0; c < 4; ++c) {
           win.qu[c] = static_cast<float>(
-              cu[c] + margin_px * (kCornerE[c] * eu / e_len + kCornerN[c] * nu / n_len));
+              cu[c] + grow_px * (kCornerE[c] * eu / e_len + kCornerN[c] * nu / n_len));
           win.qv[c] = static_cast<float>(
-              cv[c] + margin_px * (kCornerE[c] * ev / e_len + kCornerN[c] * nv / n_len));
+              cv[c] + grow_px * (kCornerE[c] * ev / e_len + kCornerN[c] * nv / n_len));
         }
       }
       // Whole beyond doubt: inside the frame even if the prediction is off
       // by the whole margin.
       if (x0 >= 0.0 && y0 >= 0.0 && x1 <= w && y1 <= h) {
-        ++plan->expected_whole;
+        plan->whole[plan->expected_whole++] = j * codes + i;
       }
     }
   }

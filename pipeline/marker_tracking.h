@@ -27,8 +27,10 @@ namespace ceilpose {
 struct TrackingPlan {
   std::array<PixelWindow, kMaxMarkersPerFrame> windows{};
   int window_count = 0;
-  // Markers whose outline lies inside the frame by the margin: a tracked
-  // sweep that decodes fewer was wrong about where they are.
+  // Markers whose outline lies inside the frame by the margin, as map
+  // indices j * codes + i: one the last frame decoded and this tracked
+  // sweep does not was not where its window looked.
+  std::array<int32_t, kMaxMarkersPerFrame> whole{};
   int expected_whole = 0;
   double margin_px = 0.0;
   std::span<const PixelWindow> span() const {
