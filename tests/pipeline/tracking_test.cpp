@@ -18,6 +18,7 @@
 #include "sim/scenarios.h"
 #include "tests/pipeline/accuracy_support.h"
 #include "tests/pipeline/detect_scene_support.h"
+#include "tests/pipeline/independent_config_support.h"
 #include "tests/pipeline/independent_renderer_support.h"
 #include "tests/support/alloc_count.h"
 
@@ -209,14 +210,7 @@ struct Compared {
 };
 
 Compared compare(int frames, PixelFormat format, const XCamera& camera = {}) {
-  PipelineConfig config = with_mode(PipelineConfig{}, PositioningMode::kAuto, true);
-  config.intrinsics.width = camera.width;
-  config.intrinsics.height = camera.height;
-  config.intrinsics.fx = camera.fx;
-  config.intrinsics.fy = camera.fy;
-  config.intrinsics.cx = camera.cx;
-  config.intrinsics.cy = camera.cy;
-  config.intrinsics.distortion = camera.distortion;
+  PipelineConfig config = with_mode(config_for(camera), PositioningMode::kAuto, true);
   PipelineConfig whole = config;
   whole.detector.tracking = false;
   config.detector.tracking = true;
