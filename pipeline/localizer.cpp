@@ -52,8 +52,12 @@ const Localization& Localizer::localize(const ImageView& image, const FrameInfo&
   // 1. The frame on its own.
   const PipelineConfig& config = pipeline_.config();
   const bool filter = config.filter.enabled;
-  const CameraMotion motion = readout_motion(frame.timestamp_ns);
-  FullSweepReason sweep = plan_sweep(frame.timestamp_ns);
+  // The filter's state carried to this frame's time, once: for the
+  // readout's motion and for the tracking windows.
+  has_prediction_ = filter && predict_motion(filter_.motion(), frame.timestamp_ns, &predicted_) ==
+                                  PredictOutcome::kOk;
+  const CameraMotion motion = readout_motion();
+  FullSweepReason sweep = plan_sweep();
   out_.swept_px = 0;
   if (sweep == FullSweepReason::kNone) {
     pipeline_.process(image, config.positioning.mode, result_.get(), motion, plan_.span());
@@ -111,9 +115,10 @@ const Localization& Localizer::localize(const ImageView& image, const FrameInfo&
         out_.published.valid ? FixState::kCoasting : (had_fix_ ? FixState::kLost : FixState::kNone);
   }
   refusals_.count(out_.refusal);
+  const bool last_measured_before = last_measured_;
   last_measured_ = out_.measured.valid;
   remember_decoded();
-  if (has_prediction_ && out_.measured.valid) {
+  if (has_prediction_ && last_measured_before && out_.measured.valid) {
     prediction_errors_.add(std::hypot(out_.measured.pose.x_m - predicted_.x[0],
                                       out_.measured.pose.y_m - predicted_.x[1]),
                            wrap_angle_rad(out_.measured.pose.yaw_rad - predicted_.x[2]));
@@ -122,12 +127,11 @@ const Localization& Localizer::localize(const ImageView& image, const FrameInfo&
   return out_;
 }
 
-CameraMotion Localizer::readout_motion(int64_t t_ns) const {
+CameraMotion Localizer::readout_motion() const {
   CameraMotion m;
   const PipelineConfig& c = pipeline_.config();
-  if (!c.filter.enabled || !(c.intrinsics.readout_ms > 0.0)) return m;
-  MotionState s;
-  if (predict_motion(filter_.motion(), t_ns, &s) != PredictOutcome::kOk) return m;
+  if (!has_prediction_ || !(c.intrinsics.readout_ms > 0.0)) return m;
+  const MotionState& s = predicted_;
   constexpr int N = kMotionStates;
   const double yaw = s.x[2], vx = s.x[3], vy = s.x[4], w = s.x[5];
   // The optical centre sits at R(yaw)·offset from the robot: it moves by
@@ -145,13 +149,14 @@ CameraMotion Localizer::readout_motion(int64_t t_ns) const {
   return m;
 }
 
-FullSweepReason Localizer::plan_sweep(int64_t t_ns) {
+FullSweepReason Localizer::plan_sweep() {
   const PipelineConfig& c = pipeline_.config();
-  has_prediction_ = c.filter.enabled && last_measured_ &&
-                    predict_motion(filter_.motion(), t_ns, &predicted_) == PredictOutcome::kOk;
-  if (!has_prediction_) prediction_errors_.reset();
+  // Windows only from a prediction that the last frame's measurement
+  // corrected (a coasting filter's prediction is not checked).
+  const bool fix = has_prediction_ && last_measured_;
+  if (!fix) prediction_errors_.reset();
   if (!c.detector.tracking || !c.filter.enabled) return FullSweepReason::kOff;
-  if (!has_prediction_) return FullSweepReason::kNoFix;
+  if (!fix) return FullSweepReason::kNoFix;
   if (frames_since_full_ + 1 >= c.detector.full_sweep_every) return FullSweepReason::kScheduled;
   return plan_tracking(view_, c.detector, predicted_, prediction_errors_, &plan_);
 }

@@ -78,12 +78,12 @@ class Localizer {
   bool had_fix_ = false;
   RefusalHistogram refusals_;
 
-  // The filter's motion predicted to t_ns and moved to the optical centre,
-  // for a rolling shutter's readout; invalid when there is no filter, no
-  // state within the prediction horizon or no readout.
-  CameraMotion readout_motion(int64_t t_ns) const;
-  // Windows for the frame at t_ns (plan_), or why to sweep it whole.
-  FullSweepReason plan_sweep(int64_t t_ns);
+  // The filter's motion at this frame's time (predicted_) moved to the
+  // optical centre, for a rolling shutter's readout; invalid when there is
+  // no filter, no state within the prediction horizon or no readout.
+  CameraMotion readout_motion() const;
+  // Windows for this frame (plan_), or why to sweep it whole.
+  FullSweepReason plan_sweep();
   // Whether a tracked sweep found what the plan expected.
   bool tracked_sweep_held() const;
 };
