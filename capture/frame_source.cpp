@@ -119,7 +119,9 @@ Result<std::unique_ptr<FrameSource>> make_frame_source(std::string_view spec,
       return std::unique_ptr<FrameSource>(
           std::make_unique<LibcameraSource>(parsed->argument, options));
 #else
-      return bad_spec(spec, "this build has no libcamera support (libcamera-dev not found)");
+      return bad_spec(spec,
+                      "this build has no libcamera backend (CEILPOSE_LIBCAMERA=OFF, or no "
+                      "libcamera found when it was built; docs/arm64.md)");
 #endif
   }
   return bad_spec(spec, "unknown source");

@@ -8,8 +8,6 @@
 #include <cerrno>
 #include <cmath>
 #include <cstring>
-#include <opencv2/imgcodecs.hpp>
-#include <opencv2/imgproc.hpp>
 
 #include "capture/wait.h"
 #include "core/clock.h"
@@ -43,26 +41,6 @@ const char* err(int negative_errno) { return std::strerror(-negative_errno); }
 
 int64_t timeval_ns(const timeval& tv) {
   return static_cast<int64_t>(tv.tv_sec) * 1'000'000'000 + static_cast<int64_t>(tv.tv_usec) * 1000;
-}
-
-// Decodes one MJPEG frame into `img` (RGB24, preallocated at the negotiated
-// size): imdecode reuses a destination of the right size and type, so nothing
-// is allocated here beyond the JPEG decoder's own scratch. False for data that
-// is not a complete JPEG of that size.
-bool decode_mjpeg(const uint8_t* data, size_t size, Image* img) {
-  // OpenCV leaves the destination untouched when no decoder recognises the
-  // data, so the start-of-image marker is checked here.
-  if (size < 4 || data[0] != 0xFF || data[1] != 0xD8) return false;
-  cv::Mat dst(img->height(), img->width(), CV_8UC3, img->data());
-  try {
-    const cv::Mat jpeg(1, static_cast<int>(size), CV_8UC1, const_cast<uint8_t*>(data));
-    cv::imdecode(jpeg, cv::IMREAD_COLOR, &dst);
-    if (dst.data != img->data()) return false;  // other size: imdecode reallocated
-    cv::cvtColor(dst, dst, cv::COLOR_BGR2RGB);
-    return true;
-  } catch (const cv::Exception&) {
-    return false;  // OpenCV reports some corrupt streams by throwing; counted by the caller
-  }
 }
 
 }  // namespace
@@ -493,8 +471,11 @@ NextStatus V4l2Source::dequeue(Frame* out) {
   Frame f;
   if (format_ == PixelFormat::kMjpeg) {
     Image& img = decoded_[static_cast<size_t>(index)];
-    const bool ok = decode_mjpeg(static_cast<const uint8_t*>(b.start), buf.bytesused, &img);
-    if (!ok) {
+    // Into the buffer's RGB24 image at the negotiated size: a truncated,
+    // corrupt or other-sized frame is counted, never half decoded.
+    const auto decoded =
+        jpeg_.decode_fixed(static_cast<const uint8_t*>(b.start), buf.bytesused, &img);
+    if (!decoded) {
       ++stats_.corrupt;
       if (!queue_buffer(index)) begin_outage("re-queueing an undecodable buffer failed", 0);
       return NextStatus::kTimeout;

@@ -26,6 +26,7 @@
 #include "capture/exposure_timing.h"
 #include "capture/frame_source.h"
 #include "capture/v4l2_syscalls.h"
+#include "codec/jpeg_codec.h"
 
 namespace ceilpose::capture {
 
@@ -108,6 +109,7 @@ class V4l2Source final : public FrameSource {
 
   std::vector<Buffer> buffers_;
   std::vector<Image> decoded_;  // MJPEG only, one RGB24 image per buffer
+  codec::JpegCodec jpeg_;       // MJPEG only
   std::vector<RetiredBuffer> retired_;
   uint32_t generation_ = 0;
   bool streaming_ = false;

@@ -2,9 +2,9 @@
 
 #include <cmath>
 #include <cstdio>
-#include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
+#include "codec/png_codec.h"
 #include "core/text_file.h"
 #include "pipeline/localization.h"
 
@@ -112,13 +112,15 @@ void AnnotateSink::consume(const Localization& loc) {
   const std::string path = dir_ + name;
   // Encoded here and written by write_file, which does not follow a
   // symbolic link planted at the name (cv::imwrite would).
-  try {
-    if (!cv::imencode(".png", img, png_)) {
-      error_ = path + ": cannot encode the PNG";
-      return;
-    }
-  } catch (const cv::Exception& ex) {
-    error_ = path + ": cannot encode the PNG: " + ex.what();
+  const ImageView bgr{img.data,
+                      img.cols,
+                      img.rows,
+                      static_cast<int>(img.step),
+                      PixelFormat::kBgr24,
+                      img.total() * img.elemSize()};
+  // zlib's default level: pictures for people, where size matters more than time.
+  if (auto encoded = codec::encode_png(bgr, 6, &png_); !encoded) {
+    error_ = path + ": cannot encode the PNG: " + encoded.error().message;
     return;
   }
   if (auto wrote = write_file(path, png_.data(), png_.size()); !wrote)

@@ -14,6 +14,7 @@
 #include "daemon/logging.h"
 #include "daemon/service.h"
 #include "daemon/signal_channel.h"
+#include "daemon/thread_stacks.h"
 
 namespace {
 
@@ -38,6 +39,10 @@ int main(int argc, char** argv) {
   // configuration, the keystore, DDS discovery) waits for the service's
   // signal channel, which stops cleanly (signal_channel.h).
   hold_stop_signals();
+  if (auto stacks = limit_thread_stacks(); !stacks) {
+    std::fprintf(stderr, "ceilposed: %s\n", stacks.error().message.c_str());
+    return kExitFailure;
+  }
   DaemonOptions options;
   int exit_code = kExitOk;
   if (!parse_command_line(argc, argv, &options, &exit_code)) return exit_code;

@@ -13,12 +13,11 @@
 #include <fstream>
 #include <memory>
 #include <new>
-#include <opencv2/core.hpp>
-#include <opencv2/imgcodecs.hpp>
-#include <opencv2/imgproc.hpp>
 #include <sstream>
 #include <string_view>
 
+#include "codec/jpeg_codec.h"
+#include "codec/png_codec.h"
 #include "core/message_text.h"
 #include "core/text_file.h"
 #include "core/yaml_duplicate_keys.h"
@@ -32,7 +31,7 @@ namespace fmt = recording_format;
 struct RecordingReader::DecodeBuffers {
   std::vector<uint8_t> file_bytes;  // the encoded frame, reused across frames
   FrameFileInfo info;
-  cv::Mat decoded;  // decoder output for colour frames (BGR), reused
+  codec::JpegCodec jpeg;  // the decoder's handle, reused
 };
 
 std::unique_ptr<RecordingReader::DecodeBuffers, RecordingReader::DecodeBuffersDeleter>
@@ -387,20 +386,7 @@ RecordingReader::RecordingReader(RecordingReader&&) noexcept = default;
 RecordingReader& RecordingReader::operator=(RecordingReader&&) noexcept = default;
 RecordingReader::~RecordingReader() = default;
 
-// OpenCV builds its table of decoders on the first encode or decode, and on
-// Debian that registers every GDAL driver, which calls abort() when memory
-// runs out (issue 28: 32-Mpx frames on several threads under ulimit -v).
-// Built here, once, while memory is plentiful.
-static void prepare_image_codecs() {
-  static const bool ready = [] {
-    std::vector<uchar> png;
-    return cv::imencode(".png", cv::Mat(1, 1, CV_8UC1, cv::Scalar(0)), png);
-  }();
-  (void)ready;
-}
-
 Result<RecordingReader> RecordingReader::open(const std::string& dir) {
-  prepare_image_codecs();
   struct stat st {};
   if (::stat(dir.c_str(), &st) != 0) {
     return make_error(dir + ": recording directory does not exist (" + std::strerror(errno) + ")");
@@ -535,9 +521,10 @@ Result<void> RecordingReader::load_frame(size_t i, Image* out) const {
 
 namespace {
 
-// Why a frame could not be decoded when memory ran out: OpenCV catches its
-// own allocation failures and only says the data is corrupt (issue 28), so
-// a failed decode tries to allocate what it needed before blaming the file.
+// Why a frame could not be decoded when memory ran out: a decoder that fails
+// to allocate inside the library may only say the data is corrupt (issue
+// 28), so a failed decode tries to allocate what it needed before blaming
+// the file.
 std::string out_of_memory_text(int width, int height) {
   const size_t bytes = decoded_frame_bytes(width, height);
   return "not enough memory to decode this " + std::to_string(width) + "x" +
@@ -574,41 +561,22 @@ Result<void> RecordingReader::decode_frame(size_t i, Image* out, DecodeBuffers* 
   if (!read) return read;
   const auto& bytes = buffers->file_bytes;
   const FrameFileInfo& info = buffers->info;
-  const cv::Mat encoded(1, static_cast<int>(bytes.size()), CV_8UC1,
-                        const_cast<uint8_t*>(bytes.data()));
-  const auto decode_failed = [&] {
-    return make_error(frame_context(i) + ": " +
-                      (memory_for(info) ? std::string("corrupt ") + to_string(info.encoding) +
-                                              " data (decoder failed)"
-                                        : out_of_memory_text(info.width, info.height)));
-  };
-  // Grey frames decode straight into `out`; colour frames go through the
-  // reused BGR buffer because OpenCV decodes to BGR and we hand out RGB.
-  try {
-    if (info.channels == 1) {
-      out->resize(info.width, info.height, PixelFormat::kGray8);
-      cv::Mat dst(info.height, info.width, CV_8UC1, out->data());
-      cv::imdecode(encoded, cv::IMREAD_UNCHANGED, &dst);
-      if (dst.data != out->data() || dst.type() != CV_8UC1 || dst.cols != info.width ||
-          dst.rows != info.height) {
-        return decode_failed();
-      }
-    } else {
-      cv::Mat& bgr = buffers->decoded;
-      const cv::Mat result = cv::imdecode(encoded, cv::IMREAD_UNCHANGED, &bgr);
-      if (result.empty() || bgr.type() != CV_8UC3 || bgr.cols != info.width ||
-          bgr.rows != info.height) {
-        return decode_failed();
-      }
-      out->resize(info.width, info.height, PixelFormat::kRgb24);
-      cv::Mat dst(info.height, info.width, CV_8UC3, out->data());
-      cv::cvtColor(bgr, dst, cv::COLOR_BGR2RGB);
-    }
-  } catch (const cv::Exception& e) {
-    if (e.code == cv::Error::StsNoMem || !memory_for(info))
-      return make_error(frame_context(i) + ": " + out_of_memory_text(info.width, info.height));
-    return make_error(frame_context(i) + ": corrupt " + to_string(info.encoding) + " data (" +
-                      e.what() + ")");
+  // Grey files decode to GREY, colour and palette files to RGB24.
+  const auto decoded =
+      info.encoding == FrameEncoding::kPng
+          ? codec::decode_png(bytes.data(), bytes.size(), out)
+          : buffers->jpeg.decode(bytes.data(), bytes.size(),
+                                 info.channels == 1 ? PixelFormat::kGray8 : PixelFormat::kRgb24,
+                                 out);
+  if (!decoded) {
+    return make_error(
+        frame_context(i) + ": " +
+        (memory_for(info) ? decoded.error().message : out_of_memory_text(info.width, info.height)));
+  }
+  if (out->width() != info.width || out->height() != info.height) {
+    return make_error(frame_context(i) + ": decoded " + std::to_string(out->width()) + "x" +
+                      std::to_string(out->height()) + " from a " + std::to_string(info.width) +
+                      "x" + std::to_string(info.height) + " header");
   }
   return {};
 }

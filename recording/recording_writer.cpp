@@ -11,12 +11,11 @@
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
-#include <opencv2/core.hpp>
-#include <opencv2/imgcodecs.hpp>
-#include <opencv2/imgproc.hpp>
 #include <string_view>
 #include <vector>
 
+#include "codec/jpeg_codec.h"
+#include "codec/png_codec.h"
 #include "core/text_file.h"
 #include "core/unique_fd.h"
 #include "recording/frame_file.h"
@@ -91,8 +90,7 @@ struct RecordingWriter::State {
   bool ground_truth_columns = false;
   bool closed = false;
   std::vector<uint8_t> encoded;  // reused encoder output
-  cv::Mat bgr;                   // reused RGB->BGR conversion buffer
-  std::vector<int> encode_params;
+  codec::JpegCodec jpeg;
   std::string path;  // reused frame file path
 };
 
@@ -216,40 +214,15 @@ Result<void> RecordingWriter::append(const ImageView& frame, int64_t timestamp_n
     size = frame.size_bytes;
     jpeg = true;
   } else {
-    cv::Mat src;
-    switch (frame.format) {
-      case PixelFormat::kGray8:
-        src = cv::Mat(frame.height, frame.width, CV_8UC1, const_cast<uint8_t*>(frame.data),
-                      static_cast<size_t>(frame.stride_bytes));
-        break;
-      case PixelFormat::kBgr24:
-        src = cv::Mat(frame.height, frame.width, CV_8UC3, const_cast<uint8_t*>(frame.data),
-                      static_cast<size_t>(frame.stride_bytes));
-        break;
-      case PixelFormat::kRgb24:
-        cv::cvtColor(cv::Mat(frame.height, frame.width, CV_8UC3, const_cast<uint8_t*>(frame.data),
-                             static_cast<size_t>(frame.stride_bytes)),
-                     s.bgr, cv::COLOR_RGB2BGR);
-        src = s.bgr;
-        break;
-      default:
-        return make_error(frame_name() + ": cannot store pixel format " + to_string(frame.format) +
-                          " (RGB24, BGR24, GREY or MJPEG)");
+    if (frame.format != PixelFormat::kGray8 && frame.format != PixelFormat::kRgb24 &&
+        frame.format != PixelFormat::kBgr24) {
+      return make_error(frame_name() + ": cannot store pixel format " + to_string(frame.format) +
+                        " (RGB24, BGR24, GREY or MJPEG)");
     }
-    s.encode_params.clear();
-    if (jpeg) {
-      s.encode_params = {cv::IMWRITE_JPEG_QUALITY, jpeg_quality};
-    } else {
-      // Fastest zlib level: a live recorder must keep up with the camera.
-      s.encode_params = {cv::IMWRITE_PNG_COMPRESSION, 1};
-    }
-    try {
-      if (!cv::imencode(jpeg ? ".jpg" : ".png", src, s.encoded, s.encode_params)) {
-        return make_error(frame_name() + ": encoder failed");
-      }
-    } catch (const cv::Exception& e) {
-      return make_error(frame_name() + ": encoder failed (" + e.what() + ")");
-    }
+    // PNG at zlib's fastest level: a live recorder must keep up with the camera.
+    const auto encoded = jpeg ? s.jpeg.encode(frame, jpeg_quality, &s.encoded)
+                              : codec::encode_png(frame, 1, &s.encoded);
+    if (!encoded) return make_error(frame_name() + ": " + encoded.error().message);
     bytes = s.encoded.data();
     size = s.encoded.size();
   }

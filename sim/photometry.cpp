@@ -2,8 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
-#include <opencv2/imgcodecs.hpp>
-#include <opencv2/imgproc.hpp>
+#include <stdexcept>
 
 #include "sim/ceiling_scene.h"
 
@@ -299,13 +298,12 @@ void Photometry::encode(const Effects& e, uint64_t rng_seed, const float* linear
 }
 
 void Photometry::jpeg_round_trip(int quality, Image* out) {
-  // The codec sees BGR, as it would from a camera, so chroma subsampling acts
-  // on the right channels.
-  cv::Mat rgb(out->height(), out->width(), CV_8UC3, out->data(), out->stride_bytes());
-  cv::cvtColor(rgb, jpeg_bgr_, cv::COLOR_RGB2BGR);
-  cv::imencode(".jpg", jpeg_bgr_, jpeg_bytes_, {cv::IMWRITE_JPEG_QUALITY, quality});
-  cv::imdecode(jpeg_bytes_, cv::IMREAD_COLOR, &jpeg_decoded_);
-  cv::cvtColor(jpeg_decoded_, rgb, cv::COLOR_BGR2RGB);
+  // 4:2:0 chroma from RGB, as a camera's encoder does. A codec failure here
+  // is a simulator defect, not a property of the scene.
+  const auto encoded = jpeg_.encode(out->view(), quality, &jpeg_bytes_);
+  if (!encoded) throw std::runtime_error("simulated JPEG compression: " + encoded.error().message);
+  const auto decoded = jpeg_.decode_fixed(jpeg_bytes_.data(), jpeg_bytes_.size(), out);
+  if (!decoded) throw std::runtime_error("simulated JPEG compression: " + decoded.error().message);
 }
 
 }  // namespace ceilpose::sim

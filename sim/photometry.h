@@ -4,9 +4,9 @@
 // camera delivers, with the photometric effects of `Effects`.
 #include <array>
 #include <cstdint>
-#include <opencv2/core.hpp>
 #include <vector>
 
+#include "codec/jpeg_codec.h"
 #include "core/image.h"
 #include "sim/effects.h"
 
@@ -24,7 +24,7 @@ class Photometry {
   // white at unit gain); it is used as scratch and left modified. Writes an
   // RGB24 frame of the same size into `out`. `rng_seed` drives the noise and
   // the occluder's shape and place. Allocates nothing once sized, except
-  // inside OpenCV's JPEG codec when jpeg_quality > 0.
+  // inside libjpeg-turbo when jpeg_quality > 0.
   void apply(const Effects& effects, uint64_t rng_seed, float* linear, Image* out);
 
  private:
@@ -43,8 +43,7 @@ class Photometry {
   std::vector<uint8_t> encode_u8_;   // linear -> sRGB, clean path
   std::vector<float> encode_f_;      // linear -> sRGB levels before noise
   std::vector<float> normal_table_;  // standard-normal quantiles, indexed by random bits
-  cv::Mat jpeg_bgr_;
-  cv::Mat jpeg_decoded_;
+  codec::JpegCodec jpeg_;
   std::vector<uint8_t> jpeg_bytes_;
 };
 
