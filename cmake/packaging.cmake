@@ -14,8 +14,20 @@ set(CPACK_PACKAGING_INSTALL_PREFIX "/usr")
 set(CPACK_DEBIAN_FILE_NAME DEB-DEFAULT)
 set(CPACK_DEBIAN_PACKAGE_SECTION "misc")
 set(CPACK_DEBIAN_PACKAGE_PRIORITY "optional")
-# Depends from the binaries' shared libraries (dpkg-shlibdeps).
-set(CPACK_DEBIAN_PACKAGE_SHLIBDEPS ON)
+if(CMAKE_CROSSCOMPILING)
+  # dpkg-shlibdeps reads only this machine's libraries: scripts/build-arm64
+  # computes Depends from the sysroot's packages (scripts/deb-depends) and
+  # passes them to cpack as CPACK_DEBIAN_PACKAGE_DEPENDS.
+  set(CPACK_DEBIAN_PACKAGE_SHLIBDEPS OFF)
+  if(CMAKE_SYSTEM_PROCESSOR STREQUAL "aarch64")
+    set(CPACK_DEBIAN_PACKAGE_ARCHITECTURE "arm64")
+  else()
+    message(FATAL_ERROR "packaging: no Debian architecture for ${CMAKE_SYSTEM_PROCESSOR}")
+  endif()
+else()
+  # Depends from the binaries' shared libraries (dpkg-shlibdeps).
+  set(CPACK_DEBIAN_PACKAGE_SHLIBDEPS ON)
+endif()
 set(CPACK_DEBIAN_PACKAGE_DESCRIPTION
     "Localizes a robot from coded ceiling markers seen by an upward camera and\npublishes its pose on POSIX shared memory and DDS (ROS 2 geometry_msgs).")
 

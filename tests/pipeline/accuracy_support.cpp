@@ -24,7 +24,9 @@ int accuracy_frames(int release_frames) {
     const int n = std::atoi(env);
     if (n > 0) return n;
   }
-#ifdef CEILPOSE_SANITIZED
+#if defined(CEILPOSE_SANITIZED) || defined(CEILPOSE_EMULATED)
+  // Sanitizers and qemu-aarch64 (scripts/build-arm64) run this code 5-20x
+  // slower: a fifth of the frames, against the same limits.
   return std::max(20, release_frames / 5);
 #else
   return release_frames;

@@ -7,6 +7,7 @@ Run by ctest with CEILPOSE_CLIENT_LIBRARY (the built C client), PYTHONPATH
 import ctypes
 import math
 import os
+import statistics
 import subprocess
 import tempfile
 import time
@@ -53,11 +54,9 @@ class ClientAgainstDaemon(unittest.TestCase):
             pass
         cls.dir.cleanup()
 
-    def settled_pose(self):
-        pose = None
-        for _ in range(30):  # one second: the filter's velocity settles
-            pose = self.client.wait_next(timeout_s=2.0)
-        return pose
+    def settled_poses(self):
+        """The next 30 poses (a second at 30 fps: the filter's velocity settles)."""
+        return [self.client.wait_next(timeout_s=2.0) for _ in range(30)]
 
     def test_latest_is_a_valid_filtered_pose_on_the_grid(self):
         pose = self.client.latest()
@@ -72,20 +71,32 @@ class ClientAgainstDaemon(unittest.TestCase):
 
     def test_wait_next_returns_newer_poses_with_the_patrols_speed(self):
         first = self.client.wait_next(timeout_s=2.0)
-        pose = self.settled_pose()
+        poses = self.settled_poses()
+        pose = poses[-1]
         self.assertGreater(pose.seq, first.seq)
         self.assertGreater(pose.capture_mono_ns, first.capture_mono_ns)
-        self.assertTrue(pose.has_motion)
-        self.assertAlmostEqual(math.hypot(pose.vx_mps, pose.vy_mps), 1.2, delta=0.05)
+        self.assertTrue(all(p.has_motion for p in poses))
+        speed = statistics.median(math.hypot(p.vx_mps, p.vy_mps) for p in poses)
+        self.assertAlmostEqual(speed, 1.2, delta=0.05)
         self.assertGreater(pose.velocity_covariance[0], 0.0)
 
     def test_predict_moves_the_pose_along_its_velocity(self):
-        pose = self.settled_pose()
-        ahead = self.client.predict(pose.capture_mono_ns + 100_000_000)  # 100 ms
-        moved = math.hypot(ahead.x_m - pose.x_m, ahead.y_m - pose.y_m)
-        self.assertAlmostEqual(moved, 0.12, delta=0.01)  # 1.2 m/s
-        self.assertGreater(ahead.covariance[0], pose.covariance[0])
-        self.assertEqual(ahead.capture_mono_ns, pose.capture_mono_ns)
+        # Each of several poses predicted 100 ms ahead: the median moves
+        # 0.12 m at the patrol's 1.2 m/s. One pose alone can be off: the
+        # synthetic camera's edges are not anti-aliased, and two frames after
+        # a marker row enters the view the solver reads a 0.17 deg tilt that
+        # is not there (tests/daemon, FilteredPosesCarryVelocityForPrediction).
+        moved = []
+        for _ in range(10):
+            pose = self.client.wait_next(timeout_s=2.0)
+            ahead = self.client.predict(pose.capture_mono_ns + 100_000_000)  # 100 ms
+            if ahead.seq != pose.seq:
+                continue  # a newer frame arrived between the two reads
+            moved.append(math.hypot(ahead.x_m - pose.x_m, ahead.y_m - pose.y_m))
+            self.assertGreater(ahead.covariance[0], pose.covariance[0])
+            self.assertEqual(ahead.capture_mono_ns, pose.capture_mono_ns)
+        self.assertGreaterEqual(len(moved), 3)
+        self.assertAlmostEqual(statistics.median(moved), 0.12, delta=0.01)  # 1.2 m/s
         now = self.client.predict()  # default: now
         self.assertTrue(now.valid)
 
