@@ -22,6 +22,7 @@
 #include <tuple>
 #include <vector>
 
+#include "codec/jpeg_codec.h"
 #include "core/clock.h"
 #include "pipeline/localizer.h"
 #include "sim/camera_format.h"
@@ -320,6 +321,43 @@ void BM_AprilTag(benchmark::State& state) {
   tag36h11_destroy(family);
 }
 
+// Issue 29 #2: what an MJPEG camera's frame costs before the pipeline sees
+// it. The ceiling frames encoded as a UVC camera does (4:2:0, quality 85),
+// decoded by codec/ in full (what capture does) or at 1/2 or 1/4 scale in
+// libjpeg-turbo's DCT (docs/pipeline_speed.md, "MJPEG").
+void BM_MjpegDecode(benchmark::State& state) {
+  const int width_px = static_cast<int>(state.range(0));
+  const int scale = static_cast<int>(state.range(1));
+  codec::JpegCodec codec;
+  std::vector<std::vector<uint8_t>> jpegs;
+  for (const Image& frame : ceiling_frames(width_px)) {
+    jpegs.emplace_back();
+    if (!codec.encode(frame.view(), 85, &jpegs.back())) {
+      state.SkipWithError("encoding failed");
+      return;
+    }
+  }
+  Image decoded;
+  std::vector<double> frame_ns;
+  frame_ns.reserve(1 << 16);
+  size_t i = 0, bytes = 0;
+  for (auto _ : state) {
+    const std::vector<uint8_t>& jpeg = jpegs[i++ % jpegs.size()];
+    const int64_t t0 = clock_ns(CLOCK_THREAD_CPUTIME_ID);
+    const auto ok = codec.decode(jpeg.data(), jpeg.size(), PixelFormat::kRgb24, &decoded, scale);
+    if (frame_ns.size() < frame_ns.capacity())
+      frame_ns.push_back(static_cast<double>(clock_ns(CLOCK_THREAD_CPUTIME_ID) - t0));
+    if (!ok) {
+      state.SkipWithError(ok.error().message.c_str());
+      return;
+    }
+    bytes += jpeg.size();
+  }
+  state.counters["median_cpu_ms"] = median(frame_ns) * 1e-6;
+  state.counters["kB_per_frame"] = static_cast<double>(bytes) / 1024.0 /
+                                   static_cast<double>(state.iterations());
+}
+
 BENCHMARK(BM_Pipeline)
     ->ArgNames({"width", "readout_ms"})
     ->Args({320, 0})
@@ -330,6 +368,10 @@ BENCHMARK(BM_Pipeline)
 BENCHMARK(BM_Drive)
     ->ArgsProduct({{320, 640, 1280}, {0, 1}, {0, 1}})
     ->ArgNames({"width", "yuyv", "tracking"})
+    ->Unit(benchmark::kMicrosecond);
+BENCHMARK(BM_MjpegDecode)
+    ->ArgsProduct({{640, 1280}, {1, 2, 4}})
+    ->ArgNames({"width", "scale"})
     ->Unit(benchmark::kMicrosecond);
 BENCHMARK(BM_AprilTag)
     ->ArgsProduct({{320, 640, 1280}, {2, 1}})
