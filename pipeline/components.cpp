@@ -95,10 +95,13 @@ void ComponentLabeler::classify_span(const ImageView& frame, int y, int x0, int 
       for (int x = x0; x <= x1; ++x, p += 3) out[x] = lut[t0[p[0]] | t1[p[1]] | t2[p[2]]];
       return;
     }
-    case PixelFormat::kYuyv: {
-      // Y0 U Y1 V per pixel pair: a pair shares its chroma, whose terms are
-      // computed once. yuv_to_rgb's arithmetic, in ints held in registers
-      // (through its pointers the compiler kept them in memory: 2.2x RGB).
+    case PixelFormat::kYuyv:
+    case PixelFormat::kNv12:
+    case PixelFormat::kYuv420: {
+      // A pixel pair shares its chroma (YUYV: Y0 U Y1 V; 4:2:0: one U, V per
+      // 2x2 block, from the chroma planes), whose terms are computed once.
+      // yuv_to_rgb's arithmetic, in ints held in registers (through its
+      // pointers the compiler kept them in memory: 2.2x RGB).
       const uint32_t* tr = classifier.table(0);
       const uint32_t* tg = classifier.table(1);
       const uint32_t* tb = classifier.table(2);
@@ -107,13 +110,31 @@ void ComponentLabeler::classify_span(const ImageView& frame, int y, int x0, int 
         const int c = 298 * (luma - 16) + 128;
         return lut[tr[level(c + rc)] | tg[level(c + gc)] | tb[level(c + bc)]];
       };
-      int x = x0;
-      const uint8_t* q = row + 4 * (x / 2);
-      for (; x <= x1; q += 4) {
-        const int d = q[1] - 128, e = q[3] - 128;
-        const int rc = 409 * e, gc = -100 * d - 208 * e, bc = 516 * d;
-        if ((x & 1) == 0) out[x++] = classify(q[0], rc, gc, bc);
-        if (x <= x1) out[x++] = classify(q[2], rc, gc, bc);
+      // One pass over the pairs of [x0, x1]: luma of the pair's two pixels
+      // and its U, V, wherever the format keeps them.
+      auto sweep = [&](auto luma_of, auto chroma_of) {
+        for (int x = x0; x <= x1;) {
+          const int pair = x >> 1;
+          int u = 0, v = 0;
+          chroma_of(pair, &u, &v);
+          const int d = u - 128, e = v - 128;
+          const int rc = 409 * e, gc = -100 * d - 208 * e, bc = 516 * d;
+          if ((x & 1) == 0) out[x] = classify(luma_of(x), rc, gc, bc), ++x;
+          if (x <= x1) out[x] = classify(luma_of(x), rc, gc, bc), ++x;
+        }
+      };
+      if (frame.format == PixelFormat::kYuyv) {
+        sweep([row](int x) { return row[2 * x]; },
+              [row](int pair, int* u, int* v) { *u = row[4 * pair + 1], *v = row[4 * pair + 3]; });
+      } else if (frame.format == PixelFormat::kNv12) {
+        const uint8_t* uv = frame.uv_row(y);
+        sweep([row](int x) { return row[x]; },
+              [uv](int pair, int* u, int* v) { *u = uv[2 * pair], *v = uv[2 * pair + 1]; });
+      } else {
+        const uint8_t* us = frame.u_row(y);
+        const uint8_t* vs = frame.v_row(y);
+        sweep([row](int x) { return row[x]; },
+              [us, vs](int pair, int* u, int* v) { *u = us[pair], *v = vs[pair]; });
       }
       return;
     }
