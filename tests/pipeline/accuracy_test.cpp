@@ -6,6 +6,7 @@
 // fewer frames run (accuracy_frames); their p99 stays below these limits.
 #include <gtest/gtest.h>
 
+#include <cstdlib>
 #include <iostream>
 
 #include "accuracy_support.h"
@@ -72,16 +73,22 @@ TEST(Accuracy, TiltedCameraWithLeastSquaresStaysNearItsMeasuredAccuracy) {
 // errors to within the noise measured between formats.
 class AccuracyInCameraFormats : public ::testing::TestWithParam<const char*> {};
 
+PipelineConfig experiment_config() {
+  PipelineConfig config;
+  if (std::getenv("CEILPOSE_EXPERIMENT_NO_TILT")) config.positioning.lsq_estimate_tilt = false;
+  return config;
+}
+
 TEST_P(AccuracyInCameraFormats, StaysWithinNoiseOfRgb) {
   const int frames = testing::accuracy_frames(60);
-  const AccuracyReport rgb =
-      testing::run_scenario(GetParam(), frames, kSeed, PositioningMode::kAuto);
+  const AccuracyReport rgb = testing::run_scenario(
+      GetParam(), frames, kSeed, PositioningMode::kAuto, false, experiment_config());
   print_row(std::string(GetParam()) + " RGB24", rgb);
   ASSERT_GT(rgb.frames_with_whole, 0);
   for (PixelFormat format : {PixelFormat::kYuyv, PixelFormat::kNv12, PixelFormat::kYuv420}) {
     const AccuracyReport r =
         testing::run_scenario(GetParam(), frames, kSeed, PositioningMode::kAuto, false,
-                              PipelineConfig{}, nullptr, 0.0, format);
+                              experiment_config(), nullptr, 0.0, format);
     print_row(std::string(GetParam()) + " " + to_string(format), r);
     EXPECT_EQ(r.gross, 0) << to_string(format);
     EXPECT_EQ(r.valid_without_whole, 0) << to_string(format);
