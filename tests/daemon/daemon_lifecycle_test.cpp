@@ -245,10 +245,23 @@ TEST_F(DaemonLifecycle, TruncatingTheSegmentKillsNeitherTheDaemonNorItsReaders) 
             std::string::npos)
       << daemon->err();
   const uint64_t before = pose.seq;
-  if (reader->liveness() == Liveness::kRestarted) {
-    ASSERT_TRUE(reader->reattach());
+  // The daemon grows the file back and says so before the next pose
+  // restores the header; until then a reader may find the segment zeroed
+  // (wait_next returns at once) or restarted (re-attach). Read on until a
+  // newer pose or 5 s (a CI run under ASan lost this race).
+  const auto deadline = Clock::now() + milliseconds(5000);
+  pose = PoseRecord{};
+  while (pose.seq <= before && Clock::now() < deadline) {
+    if (reader->liveness() == Liveness::kRestarted) {
+      ASSERT_TRUE(reader->reattach());
+    }
+    PoseRecord next{};
+    if (reader->wait_next(before, 200, &next) == WaitResult::kPose) {
+      pose = next;
+    } else {
+      std::this_thread::sleep_for(milliseconds(10));
+    }
   }
-  pose = next_pose(*reader, before);
   EXPECT_GT(pose.seq, before) << "poses flow again, numbered on";
   EXPECT_TRUE(pose_is_valid(pose));
   daemon->signal(SIGTERM);
