@@ -1,8 +1,10 @@
 #pragma once
 // One pixel's colour in any uncompressed camera format (core/image.h), for
 // sparse reads (the classifier's white sample, dot slots) and conversions
-// that are not per frame; the detector's full-frame sweeps do the same
-// arithmetic inline (pipeline/components.cpp).
+// that are not per frame. A pixel gets its pair's chroma, which is right
+// inside a uniform area (tile, dot slot); the detector's sweeps, which must
+// place coloured edges, interpolate chroma between pairs instead
+// (pipeline/components.cpp).
 #include <algorithm>
 #include <cstdint>
 
