@@ -53,9 +53,11 @@ struct SourceOptions {
   int height = 480;
   double fps = 30.0;
   // V4L2 pixel formats in order of preference; a refused one falls through to
-  // the next. YUYV first: raw, zero-copy and cheap to threshold.
-  std::vector<PixelFormat> pixel_formats{PixelFormat::kYuyv, PixelFormat::kRgb24,
-                                         PixelFormat::kBgr24, PixelFormat::kMjpeg};
+  // the next. YUYV first: raw, zero-copy and cheap to threshold; then the
+  // 4:2:0 formats of ISPs and Pi cameras, read natively too.
+  std::vector<PixelFormat> pixel_formats{PixelFormat::kYuyv,   PixelFormat::kNv12,
+                                         PixelFormat::kYuv420, PixelFormat::kRgb24,
+                                         PixelFormat::kBgr24,  PixelFormat::kMjpeg};
   // Driver buffers (V4L2 mmap, libcamera) or frame slots (replay, synthetic).
   // The pipeline holds one, the ring a few, the driver needs at least one.
   int buffer_count = 4;

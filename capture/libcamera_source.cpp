@@ -4,6 +4,7 @@
 #include <spdlog/spdlog.h>
 #include <sys/mman.h>
 
+#include <algorithm>
 #include <cerrno>
 #include <chrono>
 #include <cmath>
@@ -32,6 +33,12 @@ bool to_libcamera(PixelFormat f, lc::PixelFormat* out) {
       return true;
     case PixelFormat::kGray8:
       *out = lc::formats::R8;
+      return true;
+    case PixelFormat::kNv12:
+      *out = lc::formats::NV12;
+      return true;
+    case PixelFormat::kYuv420:
+      *out = lc::formats::YUV420;
       return true;
     case PixelFormat::kMjpeg:
       return false;  // not offered by libcamera pipelines we target
@@ -152,7 +159,19 @@ Result<void> LibcameraSource::do_start() {
   mappings_.clear();
   for (size_t i = 0; i < buffers.size(); ++i) {
     const lc::FrameBuffer::Plane& plane = buffers[i]->planes()[0];
-    const size_t map_length = plane.offset + plane.length;
+    // The detector reads a 4:2:0 frame's chroma planes right after the luma
+    // (core/image.h), as one contiguous mapping of one buffer.
+    size_t expected_offset = plane.offset;
+    size_t map_length = plane.offset + plane.length;
+    for (const lc::FrameBuffer::Plane& other : buffers[i]->planes()) {
+      if (other.fd.get() != plane.fd.get() || other.offset != expected_offset) {
+        return make_error(name + ": the " + to_string(format_) +
+                          " buffer's planes are not contiguous in one buffer; use "
+                          "capture.pixel_format yuyv or rgb24");
+      }
+      expected_offset = other.offset + other.length;
+      map_length = std::max(map_length, static_cast<size_t>(other.offset + other.length));
+    }
     void* p = mmap(nullptr, map_length, PROT_READ, MAP_SHARED, plane.fd.get(), 0);
     if (p == MAP_FAILED) {
       unmap_all();
@@ -223,12 +242,9 @@ NextStatus LibcameraSource::do_next(Frame* out, int timeout_ms) {
   const lc::FrameBuffer* buffer = request->findBuffer(stream_);
   const Mapping& m = mappings_[index];
   Frame f;
-  f.image = ImageView{static_cast<const uint8_t*>(m.start) + m.offset,
-                      width_,
-                      height_,
-                      stride_bytes_,
-                      format_,
-                      buffer->planes()[0].length};
+  f.image = ImageView{
+      static_cast<const uint8_t*>(m.start) + m.offset, width_, height_, stride_bytes_, format_,
+      frame_bytes(format_, stride_bytes_, height_)};
   // SensorTimestamp marks the first row's readout on CLOCK_BOOTTIME; the
   // buffer's own timestamp (pipelines without it) is the V4L2 end-of-frame
   // stamp on CLOCK_MONOTONIC. Either becomes the centre row's mid-exposure.

@@ -3,6 +3,8 @@
 #include <cstring>
 #include <opencv2/imgproc.hpp>
 
+#include "core/pixel_read.h"
+
 namespace ceilpose::capture {
 
 Result<void> to_rgb24(const ImageView& in, Image* out, bool keep_gray) {
@@ -34,6 +36,16 @@ Result<void> to_rgb24(const ImageView& in, Image* out, bool keep_gray) {
       return {};
     case PixelFormat::kYuyv:
       cv::cvtColor(src(CV_8UC2), dst, cv::COLOR_YUV2RGB_YUYV);
+      return {};
+    case PixelFormat::kNv12:
+    case PixelFormat::kYuv420:
+      // The detector's own conversion (read_rgb), so that a recording of a
+      // 4:2:0 camera replays as the camera was seen; not a per-frame path.
+      for (int y = 0; y < in.height; ++y) {
+        uint8_t* d = out->row(y);
+        for (int x = 0; x < in.width; ++x)
+          read_rgb(in, x, y, &d[3 * x], &d[3 * x + 1], &d[3 * x + 2]);
+      }
       return {};
     case PixelFormat::kMjpeg:
       break;

@@ -27,6 +27,10 @@ uint32_t fourcc_of(PixelFormat f) {
       return V4L2_PIX_FMT_YUYV;
     case PixelFormat::kMjpeg:
       return V4L2_PIX_FMT_MJPEG;
+    case PixelFormat::kNv12:
+      return V4L2_PIX_FMT_NV12;
+    case PixelFormat::kYuv420:
+      return V4L2_PIX_FMT_YUV420;
   }
   return 0;
 }

@@ -236,6 +236,8 @@ void describe(V& v, ServiceConfig& c) {
     v.choice("pixel_format", s.pixel_formats,
              Choices<Formats>{{"auto", capture::SourceOptions{}.pixel_formats},
                               {"yuyv", Formats{PixelFormat::kYuyv}},
+                              {"nv12", Formats{PixelFormat::kNv12}},
+                              {"yuv420", Formats{PixelFormat::kYuv420}},
                               {"mjpeg", Formats{PixelFormat::kMjpeg}},
                               {"rgb24", Formats{PixelFormat::kRgb24}},
                               {"bgr24", Formats{PixelFormat::kBgr24}},

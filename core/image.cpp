@@ -14,6 +14,10 @@ const char* to_string(PixelFormat f) {
       return "YUYV";
     case PixelFormat::kMjpeg:
       return "MJPEG";
+    case PixelFormat::kNv12:
+      return "NV12";
+    case PixelFormat::kYuv420:
+      return "YUV420";
   }
   return "unknown";
 }

@@ -7,12 +7,21 @@
 namespace ceilpose {
 
 // Pixel layouts a camera can deliver. MJPEG is compressed: capture decodes it
-// before the pipeline sees the frame.
-enum class PixelFormat : uint8_t { kGray8, kRgb24, kBgr24, kYuyv, kMjpeg };
+// before the pipeline sees the frame. The 4:2:0 formats (Pi cameras through
+// libcamera, many V4L2 ISPs) are planar, as V4L2's single-plane formats lay
+// them out: the luma plane (height rows of stride_bytes), then the chroma at
+// half resolution in both directions for each 2x2 block -- NV12 one plane of
+// (height+1)/2 rows of interleaved U, V bytes with the luma's stride; YUV420
+// (I420) a U plane then a V plane of (height+1)/2 rows of stride_bytes/2.
+// Both hold stride_bytes x (height + (height+1)/2) bytes; width is even.
+enum class PixelFormat : uint8_t { kGray8, kRgb24, kBgr24, kYuyv, kMjpeg, kNv12, kYuv420 };
 
+// Bytes per pixel of a row; for the 4:2:0 formats, of the luma plane's row.
 inline int bytes_per_pixel(PixelFormat f) {
   switch (f) {
     case PixelFormat::kGray8:
+    case PixelFormat::kNv12:
+    case PixelFormat::kYuv420:
       return 1;
     case PixelFormat::kRgb24:
     case PixelFormat::kBgr24:
@@ -23,6 +32,16 @@ inline int bytes_per_pixel(PixelFormat f) {
       return 0;
   }
   return 0;
+}
+
+inline bool is_yuv420(PixelFormat f) {
+  return f == PixelFormat::kNv12 || f == PixelFormat::kYuv420;
+}
+
+// Bytes an uncompressed frame occupies, every plane included.
+inline size_t frame_bytes(PixelFormat f, int stride_bytes, int height) {
+  const size_t rows = static_cast<size_t>(height) + (is_yuv420(f) ? (height + 1) / 2 : 0);
+  return static_cast<size_t>(stride_bytes) * rows;
 }
 
 const char* to_string(PixelFormat f);
@@ -37,6 +56,18 @@ struct ImageView {
 
   bool empty() const { return data == nullptr || width <= 0 || height <= 0; }
   const uint8_t* row(int y) const { return data + static_cast<ptrdiff_t>(y) * stride_bytes; }
+  // 4:2:0 chroma of luma row y (the layouts of PixelFormat). NV12: U of
+  // pixel x at uv_row(y)[x & ~1], V at [x | 1]. YUV420: u_row(y)[x / 2],
+  // v_row(y)[x / 2].
+  const uint8_t* uv_row(int y) const {
+    return row(height) + static_cast<ptrdiff_t>(y / 2) * stride_bytes;
+  }
+  const uint8_t* u_row(int y) const {
+    return row(height) + static_cast<ptrdiff_t>(y / 2) * (stride_bytes / 2);
+  }
+  const uint8_t* v_row(int y) const {
+    return row(height) + static_cast<ptrdiff_t>((height + 1) / 2 + y / 2) * (stride_bytes / 2);
+  }
 };
 
 // An owning, tightly packed image. Allocates only in resize().
@@ -49,7 +80,7 @@ class Image {
     height_ = height;
     format_ = format;
     stride_bytes_ = width * bytes_per_pixel(format);
-    pixels_.resize(static_cast<size_t>(stride_bytes_) * static_cast<size_t>(height));
+    pixels_.resize(frame_bytes(format, stride_bytes_, height));
   }
   int width() const { return width_; }
   int height() const { return height_; }

@@ -106,7 +106,8 @@ class FrameRecorder {
       writer_.emplace(std::move(w).value());
     }
     ImageView view = frame.image;
-    if (view.format == PixelFormat::kYuyv) {
+    // Recordings store RGB, grey or the camera's JPEG (SPEC §4).
+    if (view.format == PixelFormat::kYuyv || is_yuv420(view.format)) {
       if (auto r = capture::to_rgb24(view, &converted_); !r)
         return fail(kExitFailure, r.error().message);
       view = converted_.view();

@@ -10,45 +10,12 @@
 
 #include "core/ceiling_layout.h"
 #include "core/image.h"
+#include "core/pixel_read.h"
 #include "pipeline/detector_params.h"
 
 namespace ceilpose {
 
 enum class PixelClass : uint8_t { kBackground = 0, kRed = 1, kGreen = 2, kDark = 3 };
-
-// BT.601 limited range (V4L2's default quantisation for YUYV) to RGB, integer.
-inline void yuv_to_rgb(int y, int u, int v, uint8_t* r, uint8_t* g, uint8_t* b) {
-  const int c = 298 * (y - 16) + 128;
-  const int d = u - 128, e = v - 128;
-  *r = static_cast<uint8_t>(std::clamp((c + 409 * e) >> 8, 0, 255));
-  *g = static_cast<uint8_t>(std::clamp((c - 100 * d - 208 * e) >> 8, 0, 255));
-  *b = static_cast<uint8_t>(std::clamp((c + 516 * d) >> 8, 0, 255));
-}
-
-// RGB of pixel (x, y) in any uncompressed format; grey gives r = g = b.
-// For sparse reads only (white sample, dot slots), not for full-frame sweeps.
-inline void read_rgb(const ImageView& f, int x, int y, uint8_t* r, uint8_t* g, uint8_t* b) {
-  const uint8_t* p = f.row(y);
-  switch (f.format) {
-    case PixelFormat::kRgb24:
-      *r = p[3 * x], *g = p[3 * x + 1], *b = p[3 * x + 2];
-      return;
-    case PixelFormat::kBgr24:
-      *b = p[3 * x], *g = p[3 * x + 1], *r = p[3 * x + 2];
-      return;
-    case PixelFormat::kYuyv: {
-      const uint8_t* q = p + 4 * (x / 2);
-      yuv_to_rgb(q[(x & 1) * 2], q[1], q[3], r, g, b);
-      return;
-    }
-    case PixelFormat::kGray8:
-      *r = *g = *b = p[x];
-      return;
-    case PixelFormat::kMjpeg:
-      break;
-  }
-  *r = *g = *b = 0;
-}
 
 class ColorClassifier {
  public:

@@ -95,25 +95,74 @@ void ComponentLabeler::classify_span(const ImageView& frame, int y, int x0, int 
       for (int x = x0; x <= x1; ++x, p += 3) out[x] = lut[t0[p[0]] | t1[p[1]] | t2[p[2]]];
       return;
     }
-    case PixelFormat::kYuyv: {
-      // Y0 U Y1 V per pixel pair: a pair shares its chroma, whose terms are
-      // computed once. yuv_to_rgb's arithmetic, in ints held in registers
-      // (through its pointers the compiler kept them in memory: 2.2x RGB).
+    case PixelFormat::kYuyv:
+    case PixelFormat::kNv12:
+    case PixelFormat::kYuv420: {
+      // Chroma is sampled once per pixel pair (and per row pair in 4:2:0),
+      // sited at the pair's centre (V4L2's sample locations). Giving both
+      // pixels their pair's chroma snaps every coloured edge to a pair
+      // boundary -- up to a pixel off, and the binary area centroids with
+      // it, which the tilt decision then "explains" with a tilt. So chroma
+      // is interpolated linearly at each pixel: pixel 2p lies a quarter of
+      // the way from its pair's sample to pair p-1's (weights 3:1), pixel
+      // 2p+1 to pair p+1's; in 4:2:0 rows likewise. The luma carries the
+      // edge at full resolution. yuv_to_rgb's arithmetic, in ints held in
+      // registers, scaled by 16 for the two 3:1 blends.
       const uint32_t* tr = classifier.table(0);
       const uint32_t* tg = classifier.table(1);
       const uint32_t* tb = classifier.table(2);
-      auto level = [](int v) { return std::clamp(v >> 8, 0, 255); };
-      auto classify = [&](int luma, int rc, int gc, int bc) {
-        const int c = 298 * (luma - 16) + 128;
-        return lut[tr[level(c + rc)] | tg[level(c + gc)] | tb[level(c + bc)]];
+      auto level = [](int v) { return std::clamp(v >> 12, 0, 255); };
+      auto classify = [&](int luma, int u16, int v16) {
+        const int c = 16 * (298 * (luma - 16) + 128);
+        const int d = u16 - 16 * 128, e = v16 - 16 * 128;
+        return lut[tr[level(c + 409 * e)] | tg[level(c - 100 * d - 208 * e)] |
+                   tb[level(c + 516 * d)]];
       };
-      int x = x0;
-      const uint8_t* q = row + 4 * (x / 2);
-      for (; x <= x1; q += 4) {
-        const int d = q[1] - 128, e = q[3] - 128;
-        const int rc = 409 * e, gc = -100 * d - 208 * e, bc = 516 * d;
-        if ((x & 1) == 0) out[x++] = classify(q[0], rc, gc, bc);
-        if (x <= x1) out[x++] = classify(q[2], rc, gc, bc);
+      const int last_pair = (frame.width - 1) >> 1;
+      // chroma4_of(pair): the pair's U and V times 4 (4:2:0: blended 3:1
+      // with the neighbouring chroma row).
+      auto sweep = [&](auto luma_of, auto chroma4_of) {
+        int p = x0 >> 1;
+        int prev_u = 0, prev_v = 0, cur_u = 0, cur_v = 0, next_u = 0, next_v = 0;
+        chroma4_of(std::max(p - 1, 0), &prev_u, &prev_v);
+        chroma4_of(p, &cur_u, &cur_v);
+        for (int x = x0; x <= x1; ++p) {
+          chroma4_of(std::min(p + 1, last_pair), &next_u, &next_v);
+          if ((x & 1) == 0) {
+            out[x] = classify(luma_of(x), 3 * cur_u + prev_u, 3 * cur_v + prev_v);
+            ++x;
+          }
+          if (x <= x1) {
+            out[x] = classify(luma_of(x), 3 * cur_u + next_u, 3 * cur_v + next_v);
+            ++x;
+          }
+          prev_u = cur_u, prev_v = cur_v, cur_u = next_u, cur_v = next_v;
+        }
+      };
+      // 4:2:0: the chroma row of y and the one it leans towards.
+      const int y_other = (y & 1) == 0 ? std::max(y - 2, 0) : std::min(y + 2, frame.height - 1);
+      if (frame.format == PixelFormat::kYuyv) {
+        sweep([row](int x) { return row[2 * x]; },
+              [row](int pair, int* u, int* v) {
+                *u = 4 * row[4 * pair + 1], *v = 4 * row[4 * pair + 3];
+              });
+      } else if (frame.format == PixelFormat::kNv12) {
+        const uint8_t* uv = frame.uv_row(y);
+        const uint8_t* uv_other = frame.uv_row(y_other);
+        sweep([row](int x) { return row[x]; },
+              [uv, uv_other](int pair, int* u, int* v) {
+                *u = 3 * uv[2 * pair] + uv_other[2 * pair];
+                *v = 3 * uv[2 * pair + 1] + uv_other[2 * pair + 1];
+              });
+      } else {
+        const uint8_t* us = frame.u_row(y);
+        const uint8_t* vs = frame.v_row(y);
+        const uint8_t* us_other = frame.u_row(y_other);
+        const uint8_t* vs_other = frame.v_row(y_other);
+        sweep([row](int x) { return row[x]; },
+              [us, vs, us_other, vs_other](int pair, int* u, int* v) {
+                *u = 3 * us[pair] + us_other[pair], *v = 3 * vs[pair] + vs_other[pair];
+              });
       }
       return;
     }

@@ -70,6 +70,12 @@ bool Pipeline::usable(const ImageView& frame) const {
     return false;
   const size_t row_bytes = static_cast<size_t>(frame.width) * bytes_per_pixel(frame.format);
   if (frame.stride_bytes < 0 || static_cast<size_t>(frame.stride_bytes) < row_bytes) return false;
+  if (is_yuv420(frame.format)) {
+    // Chroma pairs need an even width; the chroma planes follow the luma.
+    if (frame.width % 2 != 0 || frame.stride_bytes % 2 != 0) return false;
+    return frame.size_bytes == 0 ||
+           frame.size_bytes >= frame_bytes(frame.format, frame.stride_bytes, frame.height);
+  }
   const size_t needed = static_cast<size_t>(frame.stride_bytes) * (frame.height - 1) + row_bytes;
   return frame.size_bytes == 0 || frame.size_bytes >= needed;
 }

@@ -45,9 +45,13 @@ struct PositioningParams {
   // errors are not Gaussian. Measured on independent renders (tests/pipeline/
   // tilt_decision_test.cpp, 2026-12-03): at 100 every tilt of 0.13–0.19° was
   // left out and cost 5–7 mm; at 20, 1 level frame in 450 chose a tilt
-  // (3.1 mm off) and tilted frames of 0.1–3° kept p99 1.9 mm. Lower to
-  // follow smaller tilts, raise if level views find tilts.
-  double lsq_tilt_select_chi2 = 20.0;
+  // (3.1 mm off) and tilted frames of 0.1–3° kept p99 1.9 mm. Raised to 30
+  // (2026-12-04) when level 4:2:0 camera frames (NV12, chroma blurred over
+  // two rows) of the gradient, noise and clutter sets each had one frame at
+  // chi² 20–27 that chose a tilt of 0.03–0.13° (1.1–5.2 mm off); the tilted
+  // frames of that test keep their limits. Lower to follow smaller tilts,
+  // raise if level views find tilts.
+  double lsq_tilt_select_chi2 = 30.0;
   // ... and only when leaving the tilt out would cost position: the free
   // pose must lie more than this many of its own standard deviations from
   // the held one. Below that either answer is as good, and holding the tilt

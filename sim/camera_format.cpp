@@ -5,7 +5,59 @@
 
 namespace ceilpose::sim {
 
+namespace {
+
+// BT.601 limited range, V4L2's default quantisation.
+uint8_t luma(double r, double g, double b) {
+  return static_cast<uint8_t>(std::lround(16.0 + (65.481 * r + 128.553 * g + 24.966 * b) / 255.0));
+}
+uint8_t chroma_u(double r, double g, double b) {
+  return static_cast<uint8_t>(
+      std::lround(std::clamp(128.0 + (-37.797 * r - 74.203 * g + 112.0 * b) / 255.0, 0.0, 255.0)));
+}
+uint8_t chroma_v(double r, double g, double b) {
+  return static_cast<uint8_t>(
+      std::lround(std::clamp(128.0 + (112.0 * r - 93.786 * g - 18.214 * b) / 255.0, 0.0, 255.0)));
+}
+
+// 4:2:0: luma per pixel, U and V of each 2x2 block's mean colour, in the
+// layouts of core/image.h.
+Image convert_yuv420(const Image& rgb, PixelFormat format) {
+  const int w = rgb.width(), h = rgb.height();
+  Image out(w, h, format);
+  const ImageView view = out.view();
+  for (int y = 0; y < h; ++y) {
+    const uint8_t* s = rgb.data() + static_cast<size_t>(y) * rgb.stride_bytes();
+    for (int x = 0; x < w; ++x) out.row(y)[x] = luma(s[3 * x], s[3 * x + 1], s[3 * x + 2]);
+  }
+  for (int y = 0; y < h; y += 2) {
+    for (int x = 0; x < w; x += 2) {
+      double m[3] = {0, 0, 0};
+      int n = 0;
+      for (int yy = y; yy < std::min(y + 2, h); ++yy) {
+        for (int xx = x; xx < std::min(x + 2, w); ++xx, ++n) {
+          const uint8_t* p = rgb.data() + static_cast<size_t>(yy) * rgb.stride_bytes() + 3 * xx;
+          for (int c = 0; c < 3; ++c) m[c] += p[c];
+        }
+      }
+      for (double& c : m) c /= n;
+      const uint8_t u = chroma_u(m[0], m[1], m[2]), v = chroma_v(m[0], m[1], m[2]);
+      if (format == PixelFormat::kNv12) {
+        auto* uv = const_cast<uint8_t*>(view.uv_row(y));
+        uv[x] = u, uv[x + 1] = v;
+      } else {
+        const_cast<uint8_t*>(view.u_row(y))[x / 2] = u;
+        const_cast<uint8_t*>(view.v_row(y))[x / 2] = v;
+      }
+    }
+  }
+  return out;
+}
+
+}  // namespace
+
 Image convert_rgb(const Image& rgb, PixelFormat format) {
+  if (is_yuv420(format)) return convert_yuv420(rgb, format);
   Image out(rgb.width(), rgb.height(), format);
   for (int y = 0; y < rgb.height(); ++y) {
     const uint8_t* s = rgb.data() + static_cast<size_t>(y) * rgb.stride_bytes();
@@ -22,23 +74,21 @@ Image convert_rgb(const Image& rgb, PixelFormat format) {
           d[x] = static_cast<uint8_t>((77 * r + 150 * g + 29 * b + 128) >> 8);
           break;
         case PixelFormat::kYuyv: {
-          // BT.601 limited range; U and V from this pixel and its pair.
-          const double yl = 16.0 + (65.481 * r + 128.553 * g + 24.966 * b) / 255.0;
-          d[2 * x] = static_cast<uint8_t>(std::lround(yl));
+          // U and V from this pixel and its pair.
+          d[2 * x] = luma(r, g, b);
           if ((x & 1) == 0) {
             const int x2 = std::min(x + 1, rgb.width() - 1);
             const double r2 = 0.5 * (r + s[3 * x2]), g2 = 0.5 * (g + s[3 * x2 + 1]),
                          b2 = 0.5 * (b + s[3 * x2 + 2]);
-            const double u = 128.0 + (-37.797 * r2 - 74.203 * g2 + 112.0 * b2) / 255.0;
-            const double v = 128.0 + (112.0 * r2 - 93.786 * g2 - 18.214 * b2) / 255.0;
-            d[2 * x + 1] = static_cast<uint8_t>(std::lround(std::clamp(u, 0.0, 255.0)));
-            if (x + 1 < rgb.width())
-              d[2 * x + 3] = static_cast<uint8_t>(std::lround(std::clamp(v, 0.0, 255.0)));
+            d[2 * x + 1] = chroma_u(r2, g2, b2);
+            if (x + 1 < rgb.width()) d[2 * x + 3] = chroma_v(r2, g2, b2);
           }
           break;
         }
         case PixelFormat::kRgb24:
         case PixelFormat::kMjpeg:
+        case PixelFormat::kNv12:
+        case PixelFormat::kYuv420:
           d[3 * x] = s[3 * x], d[3 * x + 1] = s[3 * x + 1], d[3 * x + 2] = s[3 * x + 2];
           break;
       }

@@ -1,7 +1,9 @@
 #pragma once
 // A rendered RGB frame as a camera hands it over: BGR24, YUYV 4:2:2 (BT.601
 // limited range, V4L2's default quantisation for USB cameras; the chroma of
-// each pixel pair averaged, as an ISP subsamples it) or GRAY8. The detector
+// each pixel pair averaged, as an ISP subsamples it), NV12 or YUV420 4:2:0
+// (the chroma of each 2x2 block averaged; Pi cameras through libcamera) or
+// GRAY8. The detector
 // reads each natively; accuracy and speed are measured on them.
 #include "core/image.h"
 

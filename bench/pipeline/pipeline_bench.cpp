@@ -172,12 +172,15 @@ std::map<std::tuple<int, int, int>, double>& drive_median_ns() {
 // (tracking off) or, with the fix, only in the predicted windows: thread CPU
 // time of Localizer::localize per frame, median over every frame of every
 // pass through the sequence (the filter restarts at each pass).
+// The camera formats BM_Drive's "format" argument indexes.
+constexpr PixelFormat kDriveFormats[] = {PixelFormat::kRgb24, PixelFormat::kYuyv,
+                                         PixelFormat::kNv12};
+
 void BM_Drive(benchmark::State& state) {
   const int width_px = static_cast<int>(state.range(0));
-  const bool yuyv = state.range(1) != 0;
+  const int format = static_cast<int>(state.range(1));
   const bool tracking = state.range(2) != 0;
-  const std::vector<Image>& frames =
-      drive_frames(width_px, yuyv ? PixelFormat::kYuyv : PixelFormat::kRgb24);
+  const std::vector<Image>& frames = drive_frames(width_px, kDriveFormats[format]);
   if (frames.size() != kDriveFrames) {
     state.SkipWithError("the drive set did not render");
     return;
@@ -217,7 +220,7 @@ void BM_Drive(benchmark::State& state) {
   const double n = static_cast<double>(state.iterations());
   const double med = median(frame_cpu_ns);
   state.counters["swept_share"] = swept / n;
-  drive_median_ns()[{width_px, yuyv ? 1 : 0, tracking ? 1 : 0}] = med;
+  drive_median_ns()[{width_px, format, tracking ? 1 : 0}] = med;
   for (int s = 0; s < kStageCount; ++s) {
     state.counters[std::string(Pipeline::stage_name(s)) + "_us"] = median(stage_ns[s]) * 1e-3;
   }
@@ -354,8 +357,8 @@ void BM_MjpegDecode(benchmark::State& state) {
     bytes += jpeg.size();
   }
   state.counters["median_cpu_ms"] = median(frame_ns) * 1e-6;
-  state.counters["kB_per_frame"] = static_cast<double>(bytes) / 1024.0 /
-                                   static_cast<double>(state.iterations());
+  state.counters["kB_per_frame"] =
+      static_cast<double>(bytes) / 1024.0 / static_cast<double>(state.iterations());
 }
 
 BENCHMARK(BM_Pipeline)
@@ -366,8 +369,8 @@ BENCHMARK(BM_Pipeline)
     ->Args({640, 25})
     ->Unit(benchmark::kMicrosecond);
 BENCHMARK(BM_Drive)
-    ->ArgsProduct({{320, 640, 1280}, {0, 1}, {0, 1}})
-    ->ArgNames({"width", "yuyv", "tracking"})
+    ->ArgsProduct({{320, 640, 1280}, {0, 1, 2}, {0, 1}})
+    ->ArgNames({"width", "format", "tracking"})
     ->Unit(benchmark::kMicrosecond);
 BENCHMARK(BM_MjpegDecode)
     ->ArgsProduct({{640, 1280}, {1, 2, 4}})
@@ -398,14 +401,14 @@ void print_summary() {
   std::printf("\ndrive set, filter on (medians of thread CPU time per frame, ms; x AprilTag d2)\n");
   std::printf("%-10s %-6s %16s %16s %8s\n", "size", "pixels", "full sweeps", "tracked", "ratio");
   for (int width_px : {320, 640, 1280}) {
-    for (int yuyv : {0, 1}) {
-      const auto full = drive_median_ns().find({width_px, yuyv, 0});
-      const auto tracked = drive_median_ns().find({width_px, yuyv, 1});
+    for (int format : {0, 1, 2}) {
+      const auto full = drive_median_ns().find({width_px, format, 0});
+      const auto tracked = drive_median_ns().find({width_px, format, 1});
       if (full == drive_median_ns().end() || tracked == drive_median_ns().end()) continue;
       const auto tag = apriltag_median_ns().find({width_px, 2});
       const double tag_ns = tag == apriltag_median_ns().end() ? 0.0 : tag->second;
       std::printf("%4dx%-5d %-6s %7.3f (%5.1fx) %7.3f (%5.1fx) %8.2f\n", width_px, width_px * 3 / 4,
-                  yuyv ? "YUYV" : "RGB", full->second * 1e-6, tag_ns / full->second,
+                  to_string(kDriveFormats[format]), full->second * 1e-6, tag_ns / full->second,
                   tracked->second * 1e-6, tag_ns / tracked->second, tracked->second / full->second);
     }
   }

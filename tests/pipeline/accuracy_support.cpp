@@ -5,6 +5,7 @@
 #include <cstdlib>
 
 #include "pipeline/localizer.h"
+#include "sim/camera_format.h"
 #include "sim/renderer.h"
 #include "sim/scenarios.h"
 #include "sim/visibility.h"
@@ -35,7 +36,7 @@ int accuracy_frames(int release_frames) {
 
 AccuracyReport run_scenario(const std::string& name, int frames, uint64_t seed,
                             PositioningMode mode, bool filter, const PipelineConfig& config,
-                            PoseSink* also, double rendered_readout_ms) {
+                            PoseSink* also, double rendered_readout_ms, PixelFormat format) {
   sim::SceneOptions options{config.layout, config.intrinsics, seed, nullptr};
   auto scenario = sim::make_scenario(name, options, frames, seed);
   if (!scenario.ok()) {
@@ -58,7 +59,11 @@ AccuracyReport run_scenario(const std::string& name, int frames, uint64_t seed,
     info.timestamp_ns = f.timestamp_ns;
     info.has_ground_truth = true;
     info.ground_truth = f.pose;
-    const Localization& loc = localizer.localize(image.view(), info);
+    // As the camera hands the frame over (sim/camera_format.h).
+    Image converted;
+    if (format != PixelFormat::kRgb24) converted = sim::convert_rgb(image, format);
+    const Localization& loc =
+        localizer.localize(format == PixelFormat::kRgb24 ? image.view() : converted.view(), info);
     accuracy.consume(loc);
     if (also != nullptr) also->consume(loc);
   }

@@ -24,6 +24,7 @@ int accuracy_frames(int release_frames);
 AccuracyReport run_scenario(const std::string& name, int frames, uint64_t seed,
                             PositioningMode mode, bool filter = false,
                             const PipelineConfig& config = PipelineConfig{},
-                            PoseSink* also = nullptr, double rendered_readout_ms = 0.0);
+                            PoseSink* also = nullptr, double rendered_readout_ms = 0.0,
+                            PixelFormat format = PixelFormat::kRgb24);
 
 }  // namespace ceilpose::testing

@@ -16,6 +16,7 @@ namespace ceilpose {
 namespace {
 
 constexpr uint64_t kSeed = 20240601;
+constexpr double kTiltP99LimitMm = 5.2;  // the tilt set's p99 position error, least squares
 
 void print_row(const std::string& name, const AccuracyReport& r) {
   std::cout << format_report_row(name, r) << "  (x " << 100.0 * r.within_x << "%, y "
@@ -61,8 +62,46 @@ TEST(Accuracy, StressSetStaysNearItsMeasuredAccuracy) {
 TEST(Accuracy, TiltedCameraWithLeastSquaresStaysNearItsMeasuredAccuracy) {
   // 0.47 / 2.57 mm, 0.009 deg (2026-12-03; 0.48 / 2.84 mm before the tilt
   // decision weighed what leaving the tilt out costs)
-  expect_row({"tilt", PositioningMode::kLeastSquares, 1.0, 1.0, 0.94, 5.2, 0.018});
+  expect_row({"tilt", PositioningMode::kLeastSquares, 1.0, 1.0, 0.94, kTiltP99LimitMm, 0.018});
 }
+
+// Issue 29 #1: every positioning set as cameras hand frames over -- YUYV
+// 4:2:2 (USB cameras), NV12 and YUV420 4:2:0 (Pi cameras, ISPs), read by the
+// detector with no conversion pass -- against the RGB render of the same
+// frames. 4:2:0 halves the chroma vertically too, so a marker's coloured
+// edge blurs over two rows: availability must hold to a frame, and the
+// errors to within the noise measured between formats. The tilt set's
+// errors are the free-tilt fit's own precision (sigma 1-3 mm, issue 25),
+// which one format's draw of 60 frames does not measure better than
+// another's: its formats are held to the set's own limit.
+class AccuracyInCameraFormats : public ::testing::TestWithParam<const char*> {};
+
+TEST_P(AccuracyInCameraFormats, StaysWithinNoiseOfRgb) {
+  const int frames = testing::accuracy_frames(60);
+  const AccuracyReport rgb = testing::run_scenario(GetParam(), frames, kSeed,
+                                                   PositioningMode::kAuto, false, PipelineConfig{});
+  print_row(std::string(GetParam()) + " RGB24", rgb);
+  ASSERT_GT(rgb.frames_with_whole, 0);
+  for (PixelFormat format : {PixelFormat::kYuyv, PixelFormat::kNv12, PixelFormat::kYuv420}) {
+    const AccuracyReport r =
+        testing::run_scenario(GetParam(), frames, kSeed, PositioningMode::kAuto, false,
+                              PipelineConfig{}, nullptr, 0.0, format);
+    print_row(std::string(GetParam()) + " " + to_string(format), r);
+    EXPECT_EQ(r.gross, 0) << to_string(format);
+    EXPECT_EQ(r.valid_without_whole, 0) << to_string(format);
+    EXPECT_GE(r.valid_with_whole, rgb.valid_with_whole - 1) << to_string(format);
+    EXPECT_LE(r.median_error_mm, 1.5 * rgb.median_error_mm + 0.05) << to_string(format);
+    const double p99_limit_mm =
+        std::string(GetParam()) == "tilt" ? kTiltP99LimitMm : 1.5 * rgb.p99_error_mm + 0.2;
+    EXPECT_LE(r.p99_error_mm, p99_limit_mm) << to_string(format);
+  }
+}
+
+INSTANTIATE_TEST_SUITE_P(Sets, AccuracyInCameraFormats,
+                         ::testing::Values("thesis_points", "random", "nominal", "trajectory",
+                                           "drive", "gain", "gradient", "colour_cast", "noise",
+                                           "blur", "motion_blur", "jpeg", "fixtures", "occlusion",
+                                           "clutter", "stress", "tilt", "edges"));
 
 TEST(Accuracy, FramesWithoutWholeMarkerAreInvalidAndEdgesHaveNoGrossError) {
   const AccuracyReport r =

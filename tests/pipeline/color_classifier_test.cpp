@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <utility>
 #include <vector>
 
 #include "tests/pipeline/detect_scene_support.h"
@@ -148,17 +149,21 @@ TEST_F(ColorClassifierTest, AdaptFallsBackToUnitGainsOnAFrameWithoutTile) {
   EXPECT_EQ(classifier.gains(), (std::array<float, 3>{1.0f, 1.0f, 1.0f}));
 }
 
-TEST_F(ColorClassifierTest, YuyvReadsBackThePrintedColours) {
-  for (Rgb c : {layout.red, layout.green, layout.tile}) {
-    Image rgb(2, 1, PixelFormat::kRgb24);
-    test::put_rgb(&rgb, 0, 0, c);
-    test::put_rgb(&rgb, 1, 0, c);
-    const Image yuyv = test::convert_rgb(rgb, PixelFormat::kYuyv);
-    uint8_t r = 0, g = 0, b = 0;
-    read_rgb(yuyv.view(), 1, 0, &r, &g, &b);
-    EXPECT_NEAR(r, c.r, 2);
-    EXPECT_NEAR(g, c.g, 2);
-    EXPECT_NEAR(b, c.b, 2);
+TEST_F(ColorClassifierTest, YuvFormatsReadBackThePrintedColours) {
+  for (PixelFormat format : {PixelFormat::kYuyv, PixelFormat::kNv12, PixelFormat::kYuv420}) {
+    for (Rgb c : {layout.red, layout.green, layout.tile}) {
+      Image rgb(4, 3, PixelFormat::kRgb24);
+      for (int y = 0; y < 3; ++y)
+        for (int x = 0; x < 4; ++x) test::put_rgb(&rgb, x, y, c);
+      const Image yuv = test::convert_rgb(rgb, format);
+      for (auto [x, y] : {std::pair{1, 0}, std::pair{2, 1}, std::pair{3, 2}}) {
+        uint8_t r = 0, g = 0, b = 0;
+        read_rgb(yuv.view(), x, y, &r, &g, &b);
+        EXPECT_NEAR(r, c.r, 2) << to_string(format) << " " << x << "," << y;
+        EXPECT_NEAR(g, c.g, 2) << to_string(format) << " " << x << "," << y;
+        EXPECT_NEAR(b, c.b, 2) << to_string(format) << " " << x << "," << y;
+      }
+    }
   }
 }
 

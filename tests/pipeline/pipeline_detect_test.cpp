@@ -105,13 +105,14 @@ TEST_F(PipelineDetectTest, PointsCarryTheirMarkerFrameCoordinates) {
   }
 }
 
-TEST_F(PipelineDetectTest, RgbBgrAndYuyvFramesGiveTheSameDetections) {
+TEST_F(PipelineDetectTest, RgbBgrYuyvAnd420FramesGiveTheSameDetections) {
   const auto markers = four_markers(0.4);
   const Image rgb = test::render_markers(640, 480, markers, config.layout);
   pipeline.process(rgb.view(), PositioningMode::kAuto, &result);
   expect_all_found(markers, result, "rgb");
   const FrameResult from_rgb = result;
-  for (PixelFormat f : {PixelFormat::kBgr24, PixelFormat::kYuyv}) {
+  for (PixelFormat f :
+       {PixelFormat::kBgr24, PixelFormat::kYuyv, PixelFormat::kNv12, PixelFormat::kYuv420}) {
     const Image converted = test::convert_rgb(rgb, f);
     pipeline.process(converted.view(), PositioningMode::kAuto, &result);
     expect_all_found(markers, result, to_string(f));

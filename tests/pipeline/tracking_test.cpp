@@ -305,6 +305,12 @@ TEST(TrackedLocalizer, YuyvFramesTrackAsRgbDoes) {
   expect_tracking_changes_nothing(c, 0.55);
 }
 
+TEST(TrackedLocalizer, Nv12FramesTrackAsRgbDoes) {
+  // 4:2:0 chroma, as Pi cameras deliver it.
+  const Compared c = compare(testing::accuracy_frames(60), PixelFormat::kNv12);
+  expect_tracking_changes_nothing(c, 0.55);
+}
+
 // Another camera: principal point 12 / 11 px off centre, unequal focal
 // lengths and a wide-angle barrel (k1 -0.35), whose marker sides bow.
 TEST(TrackedLocalizer, AWideAngleOffCentreCameraTracksAsTheDefaultDoes) {
