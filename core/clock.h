@@ -4,6 +4,8 @@
 
 namespace ceilpose {
 
+inline constexpr int64_t kMsNs = 1'000'000;  // nanoseconds in a millisecond
+
 inline int64_t clock_ns(clockid_t id) {
   timespec ts{};
   clock_gettime(id, &ts);

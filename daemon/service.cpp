@@ -42,8 +42,9 @@
 namespace ceilpose::daemon {
 namespace {
 
-constexpr int64_t kMsNs = 1'000'000;
 constexpr int64_t kPrintPeriodNs = 100 * kMsNs;  // --print-poses: at most 10 lines a second
+// How soon a queued READY=1/RELOADING=1/STOPPING=1 is offered to systemd again.
+constexpr int64_t kQueuedRetryMs = 50;
 
 // The configured source options at the calibrated frame size.
 capture::SourceOptions source_options(const ServiceConfig& c) {
@@ -354,10 +355,13 @@ void Service::loop() {
     if (watchdog_period_ns > 0) next = std::min(next, next_watchdog);
     if (options_.print_poses) next = std::min(next, next_print);
     if (end_ns > 0) next = std::min(next, end_ns);
+    // A state message systemd has not read yet is retried every kQueuedRetryMs.
+    const int64_t most_ms = notifier_.has_queued() ? kQueuedRetryMs : 1000;
     const int timeout_ms =
-        static_cast<int>(std::clamp<int64_t>((next - now + kMsNs - 1) / kMsNs, 0, 1000));
+        static_cast<int>(std::clamp<int64_t>((next - now + kMsNs - 1) / kMsNs, 0, most_ms));
 
     const int sig = signals_.wait(timeout_ms);
+    notifier_.flush();
     if (sig == SIGTERM || sig == SIGINT) {
       spdlog::info("{}: stopping", sig == SIGTERM ? "SIGTERM" : "SIGINT");
       return;

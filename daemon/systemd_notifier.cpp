@@ -11,6 +11,8 @@
 #include <cstdlib>
 #include <cstring>
 
+#include "core/clock.h"
+
 namespace ceilpose::daemon {
 namespace {
 
@@ -62,10 +64,9 @@ SystemdNotifier::~SystemdNotifier() {
   if (fd_ >= 0) close(fd_);
 }
 
-void SystemdNotifier::send(const std::string& message, int wait_ms) {
-  if (fd_ < 0) return;
+bool SystemdNotifier::send_now(const std::string& message, int wait_ms) {
   for (;;) {
-    if (::send(fd_, message.data(), message.size(), MSG_NOSIGNAL) >= 0) return;
+    if (::send(fd_, message.data(), message.size(), MSG_NOSIGNAL) >= 0) return true;
     if (errno == EINTR) continue;
     if (errno == EAGAIN && wait_ms > 0) {
       // A connected datagram socket polls writable once the peer's queue has room.
@@ -73,10 +74,13 @@ void SystemdNotifier::send(const std::string& message, int wait_ms) {
       const int ready = poll(&p, 1, wait_ms);
       wait_ms = 0;
       if (ready > 0) continue;
+      errno = EAGAIN;
     }
-    break;
+    return false;
   }
-  const int error = errno;
+}
+
+void SystemdNotifier::count_lost(const std::string& message, int error) {
   // The first loss, then every 100th: a stuck reader must not flood the log.
   if (dropped_++ % 100 == 0) {
     const std::string first_line = message.substr(0, message.find('\n'));
@@ -86,15 +90,57 @@ void SystemdNotifier::send(const std::string& message, int wait_ms) {
   }
 }
 
-void SystemdNotifier::ready(const std::string& status) {
-  send("READY=1\nSTATUS=" + status, kStateWaitMs);
+void SystemdNotifier::flush() {
+  if (queued_.empty()) return;
+  while (!queued_.empty()) {
+    if (!send_now(queued_.front(), 0)) {
+      if (errno == EAGAIN) return;  // still full: the next flush() tries again
+      count_lost(queued_.front(), errno);
+    }
+    queued_.pop_front();
+  }
+  spdlog::info("systemd notify socket: its reader read again after {} ms; queued messages sent",
+               (monotonic_ns() - queued_since_ns_) / kMsNs);
 }
-void SystemdNotifier::status(const std::string& status) { send("STATUS=" + status, 0); }
-void SystemdNotifier::watchdog() { send("WATCHDOG=1", 0); }
-void SystemdNotifier::reloading() {
-  send("RELOADING=1\nSTATUS=reloading configuration", kStateWaitMs);
+
+void SystemdNotifier::send_state(const std::string& message) {
+  if (fd_ < 0) return;
+  const bool was_waiting = !queued_.empty();
+  if (!was_waiting) {
+    if (send_now(message, kStateWaitMs)) return;
+    if (errno != EAGAIN) return count_lost(message, errno);
+    queued_since_ns_ = monotonic_ns();
+  }
+  if (queued_.size() == kMaxQueuedStates) {
+    count_lost(queued_.front(), EAGAIN);
+    queued_.pop_front();
+  }
+  queued_.push_back(message);
+  if (!was_waiting) {
+    spdlog::warn(
+        "systemd notify socket: {} waits: its reader has read nothing for {} ms; sent as soon "
+        "as it reads again",
+        message.substr(0, message.find('\n')), kStateWaitMs);
+  } else {
+    flush();
+  }
 }
-void SystemdNotifier::reloaded() { send("READY=1", kStateWaitMs); }
-void SystemdNotifier::stopping() { send("STOPPING=1\nSTATUS=stopping", kStateWaitMs); }
+
+void SystemdNotifier::send_periodic(const std::string& message) {
+  if (fd_ < 0) return;
+  if (!queued_.empty()) {
+    flush();
+    // Behind the state messages, never before them.
+    if (!queued_.empty()) return count_lost(message, EAGAIN);
+  }
+  if (!send_now(message, 0)) count_lost(message, errno);
+}
+
+void SystemdNotifier::ready(const std::string& status) { send_state("READY=1\nSTATUS=" + status); }
+void SystemdNotifier::status(const std::string& status) { send_periodic("STATUS=" + status); }
+void SystemdNotifier::watchdog() { send_periodic("WATCHDOG=1"); }
+void SystemdNotifier::reloading() { send_state("RELOADING=1\nSTATUS=reloading configuration"); }
+void SystemdNotifier::reloaded() { send_state("READY=1"); }
+void SystemdNotifier::stopping() { send_state("STOPPING=1\nSTATUS=stopping"); }
 
 }  // namespace ceilpose::daemon

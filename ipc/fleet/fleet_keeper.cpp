@@ -10,7 +10,6 @@
 namespace ceilpose {
 namespace {
 
-constexpr int64_t kMsNs = 1'000'000;
 // Distinct (robot, reason) pairs reported before the keeper stops naming them.
 constexpr size_t kMaxReported = 1024;
 

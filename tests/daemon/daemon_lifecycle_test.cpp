@@ -16,6 +16,7 @@
 #include <vector>
 
 #include "core/exit_codes.h"
+#include "daemon/systemd_notifier.h"
 #include "ipc/shm/shm_pose_reader.h"
 #include "ipc/shm/shm_pose_writer.h"
 #include "pipeline/accuracy_metrics.h"
@@ -228,6 +229,40 @@ TEST_F(DaemonLifecycle, ANotifySocketNobodyReadsDoesNotHoldUpSigterm) {
       << daemon->err();
 }
 
+// A reader that is slow, not gone: RELOADING=1 and READY=1 of a SIGHUP that
+// found the socket full used to be dropped after 200 ms, and systemd would
+// have waited for the end of a reload that had long ended (a loaded CI run
+// lost READY=1 so). They wait, in order, ahead of every periodic message.
+TEST_F(DaemonLifecycle, AReloadIsAnnouncedOnceASlowNotifyReaderReadsAgain) {
+  auto daemon = start();
+  ASSERT_TRUE(notify_.wait_for("READY=1", kStartTimeoutMs)) << daemon->err();
+  daemon->read_error_until("message(s) lost so far", 10000);
+  ASSERT_NE(daemon->err().find("systemd notify socket: "), std::string::npos) << daemon->err();
+  daemon->signal(SIGHUP);
+  daemon->read_error_until("unchanged", 5000);
+  ASSERT_NE(daemon->err().find("SIGHUP: " + config_ + " unchanged"), std::string::npos)
+      << daemon->err();
+  EXPECT_NE(daemon->err().find("RELOADING=1 waits"), std::string::npos) << daemon->err();
+  std::this_thread::sleep_for(milliseconds(3 * daemon::SystemdNotifier::kStateWaitMs));
+
+  // Whatever the full socket held, then the reload's two messages in order.
+  std::vector<std::string> states;
+  const auto deadline = Clock::now() + milliseconds(5000);
+  while (states.size() < 2 && Clock::now() < deadline) {
+    const auto message = notify_.receive(100);
+    if (!message) continue;
+    if (message->rfind("RELOADING=1", 0) == 0 || message->rfind("READY=1", 0) == 0)
+      states.push_back(message->substr(0, message->find('\n')));
+  }
+  EXPECT_EQ(states, (std::vector<std::string>{"RELOADING=1", "READY=1"})) << daemon->err();
+  daemon->read_error_until("read again after", 2000);
+  EXPECT_NE(daemon->err().find("its reader read again after"), std::string::npos) << daemon->err();
+  daemon->signal(SIGTERM);
+  const auto exit = daemon->wait(5000);
+  ASSERT_TRUE(exit.has_value()) << daemon->err();
+  EXPECT_EQ(exit->code, ceilpose::kExitOk) << daemon->err();
+}
+
 // Issue 15: truncate(1) of the live segment (its owner's user or root) used
 // to kill the daemon with SIGBUS. It grows the file back, restores the
 // header, says so, and readers get poses again after re-attaching.
@@ -419,7 +454,7 @@ TEST_F(DaemonLifecycle, SighupLoadsTheMapAndABrokenMapKeepsTheOldOne) {
 
   { std::ofstream(config_) << config_text() << "ceiling:\n  map: " << map << "\n"; }
   daemon->signal(SIGHUP);
-  ASSERT_TRUE(notify_.wait_for("READY=1", 5000));
+  ASSERT_TRUE(notify_.wait_for("READY=1", 5000)) << daemon->err();
   // Poses published after the reload: not the ring's backlog, nor the frame
   // the pipeline was on when the new map arrived (it applies it between frames).
   auto most_markers_now = [&] {
@@ -440,7 +475,7 @@ TEST_F(DaemonLifecycle, SighupLoadsTheMapAndABrokenMapKeepsTheOldOne) {
   // The same file, now broken: the running map stays, and the log says why.
   { std::ofstream(map) << one_marker_map(1.8288) << "  - code: [3, 3]\n    x_m: 1\n    y_m: 1\n"; }
   daemon->signal(SIGHUP);
-  ASSERT_TRUE(notify_.wait_for("READY=1", 5000));
+  ASSERT_TRUE(notify_.wait_for("READY=1", 5000)) << daemon->err();
   EXPECT_LE(most_markers_now(), 1) << daemon->err();
   EXPECT_NE(daemon->err().find("keeping the running configuration: " + map + ":7"),
             std::string::npos)
