@@ -6,7 +6,6 @@
 #include <cmath>
 #include <cstdio>
 #include <memory>
-#include <numbers>
 #include <opencv2/calib3d.hpp>
 #include <opencv2/imgproc.hpp>
 #include <string>
@@ -17,6 +16,7 @@
 #include "calibration/mount_estimate.h"
 #include "calibration/mount_fragment.h"
 #include "core/output_guard.h"
+#include "core/units.h"
 #include "ctl/calibrate_robot_command.h"
 #include "ctl/calibration_options.h"
 #include "ctl/command_registry.h"
@@ -26,7 +26,6 @@
 namespace ceilpose::ctl {
 namespace {
 
-constexpr double kDeg = 180.0 / std::numbers::pi;
 constexpr int kMinViews = 10;
 // The views' corners should reach this share of a 4 x 4 grid of image cells
 // and the boards tilt at least this much, or the calibration is weak.
@@ -251,7 +250,7 @@ void run_calibrate_camera(const CameraArgs& args) {
   for (size_t v = 0; v < n; ++v) {
     cv::Mat r;
     cv::Rodrigues(rvecs[v], r);
-    const double tilt_deg = kDeg * std::acos(std::min(1.0, std::abs(r.at<double>(2, 2))));
+    const double tilt_deg = kDegPerRad * std::acos(std::min(1.0, std::abs(r.at<double>(2, 2))));
     max_tilt_deg = std::max(max_tilt_deg, tilt_deg);
     const bool outlier = held_out[v] > std::max(0.5, kOutlierRatio * median_held_out);
     flagged += outlier ? 1 : 0;
@@ -368,13 +367,13 @@ void print_mount_report(const MountEstimate& m, const std::vector<CameraSample>&
       std::fprintf(stderr, " %.2f m, line RMS %.2f mm\n", g.length_m, 1000.0 * g.rms_m);
     else
       std::fprintf(stderr, " %.0f deg, camera circle radius %.1f mm, RMS %.2f mm\n",
-                   g.turned_rad * kDeg, 1000.0 * g.radius_m, 1000.0 * g.rms_m);
+                   g.turned_rad * kDegPerRad, 1000.0 * g.radius_m, 1000.0 * g.rms_m);
   }
   std::fprintf(stderr,
                "calibrate mount: used %d turns in place (%.0f deg, camera circle RMS %.2f mm), %d "
                "straight drives (%.2f m, line RMS %.2f mm)\n",
-               m.turn_segments, m.turned_rad * kDeg, 1000.0 * m.circle_rms_m, m.straight_segments,
-               m.driven_m, 1000.0 * m.line_rms_m);
+               m.turn_segments, m.turned_rad * kDegPerRad, 1000.0 * m.circle_rms_m,
+               m.straight_segments, m.driven_m, 1000.0 * m.line_rms_m);
   if (m.backwards_m > 0.0)
     std::fprintf(stderr,
                  "calibrate mount: %.2f m of the straight drive went backwards (the image top "
@@ -413,12 +412,12 @@ void run_calibrate_mount(MountArgs& args) {
                "calibrate mount: camera %.2f +- %.2f mm forward, %.2f +- %.2f mm left of the "
                "robot origin, turned %.3f +- %.3f deg\n",
                1000.0 * m->offset_forward_m, 1000.0 * m->sigma_forward_m, 1000.0 * m->offset_left_m,
-               1000.0 * m->sigma_left_m, m->yaw_rad * kDeg, m->sigma_yaw_rad * kDeg);
+               1000.0 * m->sigma_left_m, m->yaw_rad * kDegPerRad, m->sigma_yaw_rad * kDegPerRad);
   const MountFragment fragment =
       fragment_of(*m, setup.config.mount,
                   "ceilposectl calibrate mount --replay " + args.replay.dir + ": " +
                       std::to_string(m->turn_segments) + " turns in place (" +
-                      std::to_string(std::lround(m->turned_rad * kDeg)) + " deg), " +
+                      std::to_string(std::lround(m->turned_rad * kDegPerRad)) + " deg), " +
                       std::to_string(m->straight_segments) + " straight drives.");
   if (auto wrote = write_mount_fragment(args.out_file, fragment); !wrote) {
     std::fprintf(stderr, "ceilposectl calibrate mount: %s\n", wrote.error().message.c_str());

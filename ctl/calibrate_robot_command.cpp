@@ -14,7 +14,6 @@
 #include <cmath>
 #include <cstdio>
 #include <memory>
-#include <numbers>
 #include <string>
 #include <vector>
 
@@ -22,6 +21,7 @@
 #include "calibration/mount_estimate.h"
 #include "calibration/mount_fragment.h"
 #include "core/output_guard.h"
+#include "core/units.h"
 #include "ctl/calibration_options.h"
 #include "ctl/command_registry.h"
 #include "ctl/survey_frames.h"
@@ -30,7 +30,6 @@
 namespace ceilpose::ctl {
 namespace {
 
-constexpr double kDeg = 180.0 / std::numbers::pi;
 // The camera model must explain the image points about as well as the
 // detector measures them (0.04-0.07 px on the simulated drives): a fit worse
 // than this is a camera the model (p1, p2, k3 held) cannot describe, or a
@@ -157,7 +156,7 @@ void run_calibrate_robot(const RobotArgs& args) {
   for (const MotionSegment& g : mount->segments)
     std::fprintf(stderr, "  %6.2f-%6.2f s  %-40s %.0f deg, %.2f m\n",
                  track[g.first].t_s - track.front().t_s, track[g.last].t_s - track.front().t_s,
-                 to_string(g.kind), g.turned_rad * kDeg, g.length_m);
+                 to_string(g.kind), g.turned_rad * kDegPerRad, g.length_m);
 
   std::string refusal;
   if (!(r.rms_px <= kMaxFitRmsPx))
@@ -191,9 +190,9 @@ void run_calibrate_robot(const RobotArgs& args) {
                "origin, turned %.3f +- %.3f deg (%d turns in place, %.0f deg; %d straight runs, "
                "%.2f m)\n",
                1000.0 * mount->offset_forward_m, 1000.0 * mount->sigma_forward_m,
-               1000.0 * mount->offset_left_m, 1000.0 * mount->sigma_left_m, kDeg * mount->yaw_rad,
-               kDeg * mount->sigma_yaw_rad, mount->turn_segments, kDeg * mount->turned_rad,
-               mount->straight_segments, mount->driven_m);
+               1000.0 * mount->offset_left_m, 1000.0 * mount->sigma_left_m,
+               kDegPerRad * mount->yaw_rad, kDegPerRad * mount->sigma_yaw_rad, mount->turn_segments,
+               kDegPerRad * mount->turned_rad, mount->straight_segments, mount->driven_m);
   if (mount->backwards_m > 0.0)
     std::fprintf(stderr, "  (%.2f m of the straight runs went backwards: taken as reversing)\n",
                  mount->backwards_m);
@@ -214,9 +213,9 @@ void run_calibrate_robot(const RobotArgs& args) {
                "  p1 %.6f, p2 %.6f, k3 %.5f, held at the declared camera's\n"
                "  these files are exact for localization together (--camera with --config of "
                "this mount), not apart\n",
-               kDeg * r.tilt_x_rad, kDeg * r.tilt_y_rad, kDeg * r.sigma_tilt_rad[0],
-               kDeg * r.sigma_tilt_rad[1], config.mount.lens_height_m, k.distortion[2],
-               k.distortion[3], k.distortion[4]);
+               kDegPerRad * r.tilt_x_rad, kDegPerRad * r.tilt_y_rad,
+               kDegPerRad * r.sigma_tilt_rad[0], kDegPerRad * r.sigma_tilt_rad[1],
+               config.mount.lens_height_m, k.distortion[2], k.distortion[3], k.distortion[4]);
 
   const std::string camera_comment =
       "# ceilposectl calibrate robot --replay " + args.dir + " --map " + args.map_file +

@@ -8,7 +8,6 @@
 #include <cmath>
 #include <cstdio>
 #include <memory>
-#include <numbers>
 #include <string>
 #include <vector>
 
@@ -17,6 +16,7 @@
 #include "calibration/mount_estimate.h"
 #include "calibration/mount_fragment.h"
 #include "core/output_guard.h"
+#include "core/units.h"
 #include "ctl/calibration_options.h"
 #include "ctl/command_registry.h"
 #include "ctl/replay_run.h"
@@ -25,8 +25,6 @@
 
 namespace ceilpose::ctl {
 namespace {
-
-constexpr double kDeg = 180.0 / std::numbers::pi;
 
 struct SurveyArgs {
   std::vector<std::string> dirs;
@@ -61,15 +59,15 @@ void print_summary(const SurveyReport& r, const SurveyArgs& args, double grid_m)
                "survey: %d markers mapped; sigma median %.3f mm, max %.3f mm; yaw sigma max "
                "%.4f deg\n",
                map.present_count(), 1000.0 * sigmas[sigmas.size() / 2], 1000.0 * sigmas.back(),
-               kDeg * max_sigma_yaw);
+               kDegPerRad * max_sigma_yaw);
   std::fprintf(stderr,
                "survey: largest corrections from nominal: (%d, %d) moved %.1f mm, (%d, %d) turned "
                "%.2f deg\n",
                r.largest_shift_code[0], r.largest_shift_code[1], 1000.0 * r.largest_shift_m,
-               r.largest_turn_code[0], r.largest_turn_code[1], kDeg * r.largest_turn_rad);
+               r.largest_turn_code[0], r.largest_turn_code[1], kDegPerRad * r.largest_turn_rad);
   if (!args.intrinsics)
     std::fprintf(stderr, "survey: camera tilt found: %.3f deg about x, %.3f deg about y\n",
-                 kDeg * r.tilt_x_rad, kDeg * r.tilt_y_rad);
+                 kDegPerRad * r.tilt_x_rad, kDegPerRad * r.tilt_y_rad);
   std::fprintf(stderr, "survey: markers as detected: %.3f %% of their nominal size\n",
                100.0 * r.marker_size);
   for (const SurveyDuplicate& d : r.duplicates)
@@ -158,8 +156,8 @@ void run_survey(const SurveyArgs& args) {
                  "survey: the walk's turns in place give the mount: camera %.2f +- %.2f mm "
                  "forward, %.2f +- %.2f mm left of the robot origin, turned %.3f +- %.3f deg\n",
                  1000.0 * mount->offset_forward_m, 1000.0 * mount->sigma_forward_m,
-                 1000.0 * mount->offset_left_m, 1000.0 * mount->sigma_left_m, kDeg * mount->yaw_rad,
-                 kDeg * mount->sigma_yaw_rad);
+                 1000.0 * mount->offset_left_m, 1000.0 * mount->sigma_left_m,
+                 kDegPerRad * mount->yaw_rad, kDegPerRad * mount->sigma_yaw_rad);
   } else if (!args.mount_out_file.empty()) {
     std::fprintf(stderr, "ceilposectl survey: --mount-out: %s; nothing was written\n",
                  mount.error().message.c_str());

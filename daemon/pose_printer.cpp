@@ -7,9 +7,9 @@
 #include <cmath>
 #include <cstdio>
 #include <cstring>
-#include <numbers>
 #include <string_view>
 
+#include "core/units.h"
 #include "daemon/nonblocking_write.h"
 
 namespace ceilpose::daemon {
@@ -24,14 +24,13 @@ std::string status_line(const PoseSnapshot& s, const capture::FrameLatency& late
 }
 
 std::string pose_line(const PoseSnapshot& s, int64_t start_ns) {
-  constexpr double kDeg = 180.0 / std::numbers::pi;
   const double t_s = static_cast<double>(s.capture_ns - start_ns) * 1e-9;
   char line[320];
   int n = 0;
   if (s.valid) {
     n = std::snprintf(
         line, sizeof(line), "t=%8.3f s  x=%8.4f m  y=%8.4f m  yaw=%8.2f deg  %-11s %2d markers",
-        t_s, s.pose.x_m, s.pose.y_m, s.pose.yaw_rad * kDeg,
+        t_s, s.pose.x_m, s.pose.y_m, s.pose.yaw_rad * kDegPerRad,
         s.fix == FixState::kCoasting ? "coasting" : std::string(to_string(s.mode)).c_str(),
         s.markers);
   } else {
@@ -43,10 +42,10 @@ std::string pose_line(const PoseSnapshot& s, int64_t start_ns) {
   if (s.has_ground_truth && n > 0 && n < static_cast<int>(sizeof(line))) {
     const Pose2D& g = s.ground_truth;
     n += std::snprintf(line + n, sizeof(line) - n, "  | truth x=%8.4f y=%8.4f yaw=%8.2f", g.x_m,
-                       g.y_m, g.yaw_rad * kDeg);
+                       g.y_m, g.yaw_rad * kDegPerRad);
     if (s.valid && n < static_cast<int>(sizeof(line))) {
       const double err_mm = 1000.0 * std::hypot(s.pose.x_m - g.x_m, s.pose.y_m - g.y_m);
-      const double yaw_err = wrap_angle_rad(s.pose.yaw_rad - g.yaw_rad) * kDeg;
+      const double yaw_err = wrap_angle_rad(s.pose.yaw_rad - g.yaw_rad) * kDegPerRad;
       n += std::snprintf(line + n, sizeof(line) - n, "  err %6.1f mm %6.2f deg", err_mm, yaw_err);
     }
   }

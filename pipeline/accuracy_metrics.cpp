@@ -5,6 +5,8 @@
 #include <cstdio>
 #include <numbers>
 
+#include "core/units.h"
+
 namespace ceilpose {
 namespace {
 
@@ -70,12 +72,11 @@ AccuracyReport AccuracyAccumulator::report() const {
   std::vector<double> e = error_m_, y = yaw_error_rad_;
   std::sort(e.begin(), e.end());
   std::sort(y.begin(), y.end());
-  constexpr double kDeg = 180.0 / std::numbers::pi;
   r.median_error_mm = 1000.0 * percentile(e, 0.5);
   r.p99_error_mm = 1000.0 * percentile(e, 0.99);
   r.max_error_mm = e.empty() ? 0.0 : 1000.0 * e.back();
-  r.yaw_p99_deg = kDeg * percentile(y, 0.99);
-  r.yaw_max_deg = y.empty() ? 0.0 : kDeg * y.back();
+  r.yaw_p99_deg = kDegPerRad * percentile(y, 0.99);
+  r.yaw_max_deg = y.empty() ? 0.0 : kDegPerRad * y.back();
   std::vector<double> q = nees_;
   std::sort(q.begin(), q.end());
   double sum = 0.0;

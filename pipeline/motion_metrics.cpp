@@ -2,14 +2,12 @@
 
 #include <algorithm>
 #include <cmath>
-#include <numbers>
 
+#include "core/units.h"
 #include "pipeline/accuracy_metrics.h"
 
 namespace ceilpose {
 namespace {
-
-constexpr double kDeg = 180.0 / std::numbers::pi;
 
 double sorted_percentile(std::vector<double> v, double p) {
   std::sort(v.begin(), v.end());
@@ -73,7 +71,7 @@ MotionReport MotionAccuracySink::report() const {
   r.median_error_mm = 1000.0 * sorted_percentile(err, 0.5);
   r.p99_error_mm = 1000.0 * sorted_percentile(err, 0.99);
   r.max_error_mm = 1000.0 * sorted_percentile(err, 1.0);
-  r.yaw_p99_deg = kDeg * sorted_percentile(yaw, 0.99);
+  r.yaw_p99_deg = kDegPerRad * sorted_percentile(yaw, 0.99);
   r.velocity_frames = static_cast<int>(verr.size());
   r.velocity_median_error_mps = sorted_percentile(verr, 0.5);
   r.velocity_p99_error_mps = sorted_percentile(verr, 0.99);
@@ -82,7 +80,7 @@ MotionReport MotionAccuracySink::report() const {
   r.predicted_median_error_mm = 1000.0 * sorted_percentile(perr, 0.5);
   r.predicted_p99_error_mm = 1000.0 * sorted_percentile(perr, 0.99);
   r.predicted_max_error_mm = 1000.0 * sorted_percentile(perr, 1.0);
-  r.predicted_yaw_p99_deg = kDeg * sorted_percentile(pyaw, 0.99);
+  r.predicted_yaw_p99_deg = kDegPerRad * sorted_percentile(pyaw, 0.99);
   r.unpredicted_p99_error_mm = 1000.0 * sorted_percentile(uerr, 0.99);
   return r;
 }

@@ -11,6 +11,7 @@
 #include <numbers>
 #include <numeric>
 
+#include "core/units.h"
 #include "pipeline/change_of_axes.h"
 
 namespace ceilpose {
@@ -209,7 +210,6 @@ int count_groups(const std::vector<Sighting>& home, int codes) {
 // viewpoint.
 constexpr double kViewpointM = 0.05;
 constexpr double kViewpointRad = 5.0 * std::numbers::pi / 180.0;
-constexpr double kDeg = 180.0 / std::numbers::pi;
 
 // Distinct viewpoints among the frames with a used sighting (greedy: a
 // frame far from every viewpoint so far is a new one).
@@ -450,8 +450,8 @@ Result<SurveyReport> survey_ceiling(const PipelineConfig& config,
                   "%.0f deg of another count as one), %d needed: a survey of a robot that did "
                   "not move, or of one frame repeated, cannot tell the markers' places from the "
                   "camera's errors; walk under the ceiling",
-                  frames.size(), report.viewpoints, 1000.0 * kViewpointM, kViewpointRad * kDeg,
-                  options.min_viewpoints);
+                  frames.size(), report.viewpoints, 1000.0 * kViewpointM,
+                  kViewpointRad * kDegPerRad, options.min_viewpoints);
     return make_error(why);
   }
 

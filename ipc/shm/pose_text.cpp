@@ -2,9 +2,9 @@
 
 #include <cinttypes>
 #include <cstdio>
-#include <numbers>
 
 #include "core/json_text.h"
+#include "core/units.h"
 
 namespace ceilpose {
 
@@ -21,7 +21,7 @@ double age_ms(const PoseRecord& p, int64_t now_mono_ns) {
   return static_cast<double>(now_mono_ns - p.publish_mono_ns) / 1e6;
 }
 
-double degrees(double rad) { return rad * 180.0 / std::numbers::pi; }
+double degrees(double rad) { return rad * kDegPerRad; }
 
 }  // namespace
 
