@@ -114,6 +114,9 @@ class Service {
   // segment written over or truncated, another writer of our DDS topic.
   void report_interference();
   void reload();
+  // The running ceiling (map, or nominal grid) on rt/<robot>/ceiling: at
+  // start, and again when SIGHUP changes it, so RViz never shows an old map.
+  void publish_ceiling();
   void shutdown();
   // The configuration the pipeline runs with: the file's, with a replayed
   // recording's own camera model in place of camera.* unless a calibration
@@ -247,10 +250,7 @@ int Service::start_dds() {
         "needs `ceilposectl keys add` again)",
         dds_->publishes_tf() ? "the ceiling is" : "TF (and maybe the ceiling) is",
         dds_->rviz_problem());
-  const PipelineConfig& running = running_config(config_).pipeline;
-  const CeilingMap nominal(running.layout);
-  if (auto ok = dds_->publish_ceiling(running.layout, running.map ? *running.map : nominal); !ok)
-    spdlog::warn("DDS: {}", ok.error().message);
+  publish_ceiling();
   dds_sink_.emplace(&*dds_, config_.dds.status_period_ms);
   sinks_.push_back(&*dds_sink_);
   spdlog::info("DDS: domain {} topic {}, status every {} ms", dds_->domain_id(), dds_->pose_topic(),
@@ -472,11 +472,12 @@ void Service::reload() {
   }
   const std::vector<std::string> changed = changed_config_keys(config_, *next);
   std::string applied, needs_restart;
-  bool filter_changed = false;
+  bool filter_changed = false, ceiling_changed = false;
   for (const auto& key : changed) {
     std::string& list = is_live_key(key) ? applied : needs_restart;
     list += (list.empty() ? "" : ", ") + key;
     filter_changed = filter_changed || key.rfind("filter.", 0) == 0;
+    ceiling_changed = ceiling_changed || key.rfind("ceiling.", 0) == 0;
   }
   if (changed.empty()) {
     spdlog::info("SIGHUP: {} unchanged", options_.config_path);
@@ -492,8 +493,17 @@ void Service::reload() {
       spdlog::warn("SIGHUP: {} changed but needs a restart (systemctl restart ceilposed)",
                    needs_restart);
     config_ = live;
+    if (ceiling_changed) publish_ceiling();
   }
   notifier_.reloaded();
+}
+
+void Service::publish_ceiling() {
+  if (!dds_) return;
+  const PipelineConfig& running = running_config(config_).pipeline;
+  const CeilingMap nominal(running.layout);
+  if (auto ok = dds_->publish_ceiling(running.layout, running.map ? *running.map : nominal); !ok)
+    spdlog::warn("DDS: {}", ok.error().message);
 }
 
 void Service::shutdown() {

@@ -7,6 +7,8 @@ namespace {
 
 constexpr int32_t kCubeList = 6;        // visualization_msgs/Marker CUBE_LIST
 constexpr int32_t kTextViewFacing = 9;  // TEXT_VIEW_FACING
+constexpr int32_t kAdd = 0;             // Marker actions
+constexpr int32_t kDeleteAll = 3;
 constexpr double kPrintThickness_m = 0.002;
 constexpr double kLabelDrop_m = 0.05;  // labels just below the tiles
 constexpr double kLabelHeight_m = 0.04;
@@ -23,7 +25,7 @@ void point_at(Seq* seq, std::vector<T>* items) {
 }
 
 visualization_msgs_msg_dds__Marker_ blank_marker(int64_t stamp_real_ns, const char* ns, int32_t id,
-                                                 int32_t type) {
+                                                 int32_t type, int32_t action = kAdd) {
   visualization_msgs_msg_dds__Marker_ m{};
   DdsPose stamp_only;
   stamp_only.capture_realtime_ns = stamp_real_ns;
@@ -33,7 +35,7 @@ visualization_msgs_msg_dds__Marker_ blank_marker(int64_t stamp_real_ns, const ch
   m.ns = const_cast<char*>(ns);
   m.id = id;
   m.type = type;
-  m.action = 0;  // ADD
+  m.action = action;
   m.pose.orientation.w = 1.0;
   m.texture_resource = const_cast<char*>(kEmpty);
   m.texture.header = stamped.header;
@@ -61,7 +63,10 @@ CeilingMarkers::CeilingMarkers(const CeilingLayout& layout, const CeilingMap& ma
       labels_.push_back(std::to_string(i) + "," + std::to_string(j));
     }
   const bool labelled = static_cast<int>(labels_.size()) <= kMaxLabels;
-  markers_.reserve(2 + (labelled ? labels_.size() : 0));
+  markers_.reserve(3 + (labelled ? labels_.size() : 0));
+  // First, clear what an earlier ceiling drew: a map reloaded with fewer
+  // markers must not leave the old labels standing in RViz.
+  markers_.push_back(blank_marker(stamp_real_ns, kEmpty, 0, 0, kDeleteAll));
   for (int k = 0; k < 2; ++k) {
     auto m = blank_marker(stamp_real_ns, kRectanglesNs, k, kCubeList);
     m.scale = {layout.rect_width_m, layout.rect_height_m, kPrintThickness_m};

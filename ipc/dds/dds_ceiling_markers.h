@@ -1,7 +1,8 @@
 #pragma once
 // The ceiling as RViz draws it: visualization_msgs/MarkerArray in `map`,
-// one CUBE_LIST of the red rectangles, one of the green ones, and a label
-// "i,j" under each marker (up to kMaxLabels). From the surveyed map when
+// a DELETEALL (the previous ceiling goes), one CUBE_LIST of the red
+// rectangles, one of the green ones, and a label "i,j" under each marker
+// (up to kMaxLabels). From the surveyed map when
 // there is one, else the nominal grid. Built once (it allocates); the
 // message points into this object, which must outlive the write.
 #include <string>

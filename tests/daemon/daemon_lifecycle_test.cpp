@@ -485,6 +485,39 @@ TEST_F(DaemonLifecycle, SighupLoadsTheMapAndABrokenMapKeepsTheOldOne) {
   ASSERT_TRUE(daemon->wait(5000).has_value()) << daemon->err();
 }
 
+// RViz draws the ceiling from rt/<robot>/ceiling (transient local, published
+// at start). A SIGHUP that brought a surveyed map used to leave the nominal
+// grid there: a viewer that joins later must get the map that runs.
+TEST_F(DaemonLifecycle, ASighupWithAnotherMapRepublishesTheCeiling) {
+  test::use_loopback_dds();
+  const std::string domain = std::to_string(test::unique_domain_id());
+  const std::string robot = test::unique_robot_name("map");
+  std::string with_dds = config_text();
+  with_dds.replace(with_dds.find("dds:\n  enabled: false"),
+                   std::string("dds:\n  enabled: false").size(), "dds:\n  enabled: true");
+  { std::ofstream(config_) << with_dds; }
+  auto daemon = start({"--domain", domain, "--robot", robot});
+  ASSERT_TRUE(notify_.wait_for("READY=1", kStartTimeoutMs)) << daemon->err();
+
+  const std::string map = write_temp_file("map.yaml", one_marker_map(1.8288));
+  { std::ofstream(config_) << with_dds << "ceiling:\n  map: " << map << "\n"; }
+  daemon->signal(SIGHUP);
+  ASSERT_TRUE(notify_.wait_for("READY=1", 5000)) << daemon->err();
+  ASSERT_NE(daemon->err().find("SIGHUP: applied ceiling.map"), std::string::npos) << daemon->err();
+
+  ChildProcess viewer({CEILPOSE_FASTDDS_LISTENER, "--domain", domain, "--topic",
+                       "rt/" + robot + "/ceiling", "--type", "markers", "--count", "1",
+                       "--timeout-ms", "15000"});
+  ASSERT_EQ(viewer.wait_exit(20000), 0) << viewer.output() << daemon->err();
+  const std::string& out = viewer.output();
+  // DELETEALL, the red and the green rectangle of marker (3, 3), its label.
+  EXPECT_NE(out.find("markers count=4 | "), std::string::npos) << out;
+  EXPECT_NE(out.find("action=3 "), std::string::npos) << out;
+  EXPECT_NE(out.find("text=3,3 "), std::string::npos) << out;
+  daemon->signal(SIGTERM);
+  ASSERT_TRUE(daemon->wait(5000).has_value()) << daemon->err();
+}
+
 TEST_F(DaemonLifecycle, PublishesOnDdsAndDisposesOnSigterm) {
   // DDS on loopback only, on a domain of its own (pid-derived, 100..199).
   const std::string domain = std::to_string(100 + getpid() % 100);

@@ -130,8 +130,8 @@ TEST(DdsInterop, FastDdsSubscriberDecodesTheTransformOfEveryPose) {
 
 // The ceiling as visualization_msgs/MarkerArray on rt/<robot>/ceiling,
 // published once at start and transient local: a viewer that starts later
-// still gets it. The nominal 8 x 8 grid of the default layout: the red and
-// the green rectangles as two CUBE_LISTs of 64, then 64 labels "i,j".
+// still gets it. The nominal 8 x 8 grid of the default layout: a DELETEALL,
+// the red and the green rectangles as two CUBE_LISTs of 64, then 64 labels.
 TEST(DdsInterop, ALateFastDdsViewerGetsTheCeilingWithEveryField) {
   test::use_loopback_dds();
   const std::string domain = std::to_string(test::unique_domain_id());
@@ -143,7 +143,8 @@ TEST(DdsInterop, ALateFastDdsViewerGetsTheCeilingWithEveryField) {
                            "--timeout-ms", "15000"});
   ASSERT_EQ(subscriber.wait_exit(kTimeoutMs), 0) << subscriber.output();
   const std::string& out = subscriber.output();
-  EXPECT_NE(out.find("markers count=66 | "), std::string::npos) << out;
+  EXPECT_NE(out.find("markers count=67 | "), std::string::npos) << out;
+  EXPECT_NE(out.find("ns= id=0 type=0 action=3 "), std::string::npos) << out.substr(0, 2000);
   EXPECT_NE(out.find("frame=map"), std::string::npos);
   // Red rectangles: 5 x 12 in at marker centre + 2.5 in east, on the 2.4384 m ceiling.
   EXPECT_NE(out.find("ns=ceiling id=0 type=6 action=0 x=0 y=0 z=0 qw=1 scale=0.127,0.3048,0.002 "
