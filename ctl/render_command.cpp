@@ -7,11 +7,13 @@
 #include <memory>
 #include <optional>
 #include <string>
+#include <vector>
 
 #include "calibration/board_spec.h"
 #include "calibration/camera_info_file.h"
 #include "calibration/map_file.h"
 #include "config/service_config.h"
+#include "core/output_guard.h"
 #include "ctl/calibration_options.h"
 #include "ctl/command_registry.h"
 #include "recording/recording_writer.h"
@@ -99,6 +101,21 @@ void run_render(const RenderArgs& args) {
   }
   if (args.scenario.empty() || args.out_dir.empty()) {
     std::cerr << "ceilposectl render: --scenario and --out are required (see --list)\n";
+    set_exit_code(kExitUsage);
+    return;
+  }
+  // The truth map is written before the recording: it must not replace a
+  // file render reads, nor sit inside --out, which must be empty then.
+  const std::vector<NamedPath> truth_map{{"--truth-map", args.truth_map_file}};
+  const std::vector<NamedPath> inputs{{"--config", args.config_file},
+                                      {"--camera", args.camera_file},
+                                      {"--true-camera", args.true_camera_file}};
+  const std::vector<NamedPath> recording{{"--out", args.out_dir}};
+  if (!report(check_outputs_are_not_inputs(truth_map, inputs), kExitUsage)) return;
+  if (!args.truth_map_file.empty() && !check_outputs_are_not_inputs(truth_map, {}, recording)) {
+    std::cerr << "ceilposectl render: --truth-map " << args.truth_map_file << " is inside --out "
+              << args.out_dir
+              << ", which must be empty for the recording; write the map beside it\n";
     set_exit_code(kExitUsage);
     return;
   }

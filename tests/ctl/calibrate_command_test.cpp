@@ -258,6 +258,29 @@ TEST_F(Calibrate, NoCalibrationWritesOverItsOwnInput) {
   EXPECT_TRUE(fs::exists(yaml));
 }
 
+// render --truth-map is written first: over --config it replaced the
+// configuration the frames were to be rendered with, and inside --out it
+// made the recording's directory non-empty before the recording began.
+TEST_F(Calibrate, RenderWritesItsTruthMapOverNoInputAndNotIntoItsRecording) {
+  const std::string config = write("robot.yaml", "mount:\n  lens_height_m: 0.3048\n");
+  auto over = run_ceilposectl({"render", "--scenario", "random", "--frames", "2", "--config",
+                               config, "--truth-map", config, "--out", path("r1")},
+                              kSlowMs);
+  EXPECT_EQ(over.exit_code, 2) << over.err;
+  EXPECT_NE(over.err.find("--truth-map " + config + " is --config's file"), std::string::npos)
+      << over.err;
+  std::ifstream in(config);
+  EXPECT_EQ(std::string(std::istreambuf_iterator<char>(in), {}),
+            "mount:\n  lens_height_m: 0.3048\n");
+  EXPECT_FALSE(fs::exists(path("r1")));
+  auto inside = run_ceilposectl({"render", "--scenario", "random", "--frames", "2", "--truth-map",
+                                 path("r2/map.yaml"), "--out", path("r2")},
+                                kSlowMs);
+  EXPECT_EQ(inside.exit_code, 2) << inside.err;
+  EXPECT_NE(inside.err.find("is inside --out"), std::string::npos) << inside.err;
+  EXPECT_FALSE(fs::exists(path("r2")));
+}
+
 // issue 27's robot: a camera 17 px off-centre (12, 12), non-square pixels
 // and k1 -0.22, mounted 85 mm behind and 30 mm left of the origin, turned
 // -3°, under a hand-laid ceiling whose true map is known.
