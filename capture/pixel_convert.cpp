@@ -35,16 +35,16 @@ Result<void> to_rgb24(const ImageView& in, Image* out, bool keep_gray) {
       cv::cvtColor(src(CV_8UC3), dst, cv::COLOR_BGR2RGB);
       return {};
     case PixelFormat::kYuyv:
-      cv::cvtColor(src(CV_8UC2), dst, cv::COLOR_YUV2RGB_YUYV);
-      return {};
     case PixelFormat::kNv12:
     case PixelFormat::kYuv420:
-      // The detector's own conversion (read_rgb), so that a recording of a
-      // 4:2:0 camera replays as the camera was seen; not a per-frame path.
+      // Chroma interpolated as the detector does (core/pixel_read.h), so
+      // that a recording of a YUV camera replays with the edges the live
+      // detector saw; cv::cvtColor gives both pixels of a pair their pair's
+      // chroma. Not a per-frame path of the daemon.
       for (int y = 0; y < in.height; ++y) {
         uint8_t* d = out->row(y);
         for (int x = 0; x < in.width; ++x)
-          read_rgb(in, x, y, &d[3 * x], &d[3 * x + 1], &d[3 * x + 2]);
+          read_rgb_interpolated(in, x, y, &d[3 * x], &d[3 * x + 1], &d[3 * x + 2]);
       }
       return {};
     case PixelFormat::kMjpeg:

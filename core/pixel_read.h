@@ -54,4 +54,62 @@ inline void read_rgb(const ImageView& f, int x, int y, uint8_t* r, uint8_t* g, u
   *r = *g = *b = 0;
 }
 
+// Chroma is sampled once per pixel pair (and per row pair in 4:2:0),
+// sited at the pair's centre (V4L2's sample locations). Interpolated at a
+// pixel, pixel 2p lies a quarter of the way from its pair's sample to pair
+// p-1's, pixel 2p+1 to pair p+1's (weights 3:1); 4:2:0 rows likewise. Giving
+// both pixels their pair's chroma instead snaps every coloured edge to a
+// pair boundary, and marker centroids with it. The detector's sweeps inline
+// the same rule (pipeline/components.cpp).
+inline constexpr int kChromaOwnWeight = 3;
+inline constexpr int kChromaNeighbourWeight = 1;
+// The pair whose chroma pixel x leans towards, within a row of width_px.
+inline int chroma_neighbour_pair(int x, int width_px) {
+  const int pair = x >> 1;
+  return (x & 1) == 0 ? std::max(pair - 1, 0) : std::min(pair + 1, (width_px - 1) >> 1);
+}
+// A luma row whose chroma row is the one row y leans towards (4:2:0).
+inline int chroma_neighbour_row(int y, int height_px) {
+  return (y & 1) == 0 ? std::max(y - 2, 0) : std::min(y + 2, height_px - 1);
+}
+
+// RGB of pixel (x, y) with chroma interpolated as above (YUV formats; the
+// others as read_rgb). For conversions that are not per frame in the daemon
+// (recordings of YUV cameras), so that they keep the edges the detector sees.
+inline void read_rgb_interpolated(const ImageView& f, int x, int y, uint8_t* r, uint8_t* g,
+                                  uint8_t* b) {
+  if (f.format != PixelFormat::kYuyv && !is_yuv420(f.format)) return read_rgb(f, x, y, r, g, b);
+  const int own = x >> 1, other = chroma_neighbour_pair(x, f.width);
+  int u4[2] = {0, 0}, v4[2] = {0, 0};  // own pair, neighbour pair; x4 (4:2:0: rows blended)
+  int luma = 0;
+  if (f.format == PixelFormat::kYuyv) {
+    const uint8_t* p = f.row(y);
+    luma = p[2 * x];
+    for (int k = 0; k < 2; ++k) {
+      const int pair = k == 0 ? own : other;
+      u4[k] = 4 * p[4 * pair + 1], v4[k] = 4 * p[4 * pair + 3];
+    }
+  } else {
+    luma = f.row(y)[x];
+    const int y_other = chroma_neighbour_row(y, f.height);
+    for (int k = 0; k < 2; ++k) {
+      const int pair = k == 0 ? own : other;
+      int u_near = 0, v_near = 0, u_far = 0, v_far = 0;
+      if (f.format == PixelFormat::kNv12) {
+        u_near = f.uv_row(y)[2 * pair], v_near = f.uv_row(y)[2 * pair + 1];
+        u_far = f.uv_row(y_other)[2 * pair], v_far = f.uv_row(y_other)[2 * pair + 1];
+      } else {
+        u_near = f.u_row(y)[pair], v_near = f.v_row(y)[pair];
+        u_far = f.u_row(y_other)[pair], v_far = f.v_row(y_other)[pair];
+      }
+      u4[k] = kChromaOwnWeight * u_near + kChromaNeighbourWeight * u_far;
+      v4[k] = kChromaOwnWeight * v_near + kChromaNeighbourWeight * v_far;
+    }
+  }
+  // Weights sum to 4 in each direction: u16 / 16 with rounding.
+  const int u16 = kChromaOwnWeight * u4[0] + kChromaNeighbourWeight * u4[1];
+  const int v16 = kChromaOwnWeight * v4[0] + kChromaNeighbourWeight * v4[1];
+  yuv_to_rgb(luma, (u16 + 8) >> 4, (v16 + 8) >> 4, r, g, b);
+}
+
 }  // namespace ceilpose

@@ -4,6 +4,8 @@
 #include <cmath>
 #include <cstring>
 
+#include "core/pixel_read.h"
+
 // One sweep, row by row, runs joined into components as they are found (one
 // pass over the pixels):
 //   a. classify the row into a byte buffer through the fused lookup (one
@@ -98,16 +100,10 @@ void ComponentLabeler::classify_span(const ImageView& frame, int y, int x0, int 
     case PixelFormat::kYuyv:
     case PixelFormat::kNv12:
     case PixelFormat::kYuv420: {
-      // Chroma is sampled once per pixel pair (and per row pair in 4:2:0),
-      // sited at the pair's centre (V4L2's sample locations). Giving both
-      // pixels their pair's chroma snaps every coloured edge to a pair
-      // boundary -- up to a pixel off, and the binary area centroids with
-      // it, which the tilt decision then "explains" with a tilt. So chroma
-      // is interpolated linearly at each pixel: pixel 2p lies a quarter of
-      // the way from its pair's sample to pair p-1's (weights 3:1), pixel
-      // 2p+1 to pair p+1's; in 4:2:0 rows likewise. The luma carries the
-      // edge at full resolution. yuv_to_rgb's arithmetic, in ints held in
-      // registers, scaled by 16 for the two 3:1 blends.
+      // Chroma interpolated at each pixel (core/pixel_read.h says how and
+      // why), in ints held in registers, scaled by 16 for the two blends.
+      // The sweep carries the previous, own and next pair's chroma, so each
+      // pair's is read once.
       const uint32_t* tr = classifier.table(0);
       const uint32_t* tg = classifier.table(1);
       const uint32_t* tb = classifier.table(2);
@@ -129,18 +125,22 @@ void ComponentLabeler::classify_span(const ImageView& frame, int y, int x0, int 
         for (int x = x0; x <= x1; ++p) {
           chroma4_of(std::min(p + 1, last_pair), &next_u, &next_v);
           if ((x & 1) == 0) {
-            out[x] = classify(luma_of(x), 3 * cur_u + prev_u, 3 * cur_v + prev_v);
+            out[x] =
+                classify(luma_of(x), kChromaOwnWeight * cur_u + kChromaNeighbourWeight * prev_u,
+                         kChromaOwnWeight * cur_v + kChromaNeighbourWeight * prev_v);
             ++x;
           }
           if (x <= x1) {
-            out[x] = classify(luma_of(x), 3 * cur_u + next_u, 3 * cur_v + next_v);
+            out[x] =
+                classify(luma_of(x), kChromaOwnWeight * cur_u + kChromaNeighbourWeight * next_u,
+                         kChromaOwnWeight * cur_v + kChromaNeighbourWeight * next_v);
             ++x;
           }
           prev_u = cur_u, prev_v = cur_v, cur_u = next_u, cur_v = next_v;
         }
       };
       // 4:2:0: the chroma row of y and the one it leans towards.
-      const int y_other = (y & 1) == 0 ? std::max(y - 2, 0) : std::min(y + 2, frame.height - 1);
+      const int y_other = chroma_neighbour_row(y, frame.height);
       if (frame.format == PixelFormat::kYuyv) {
         sweep([row](int x) { return row[2 * x]; },
               [row](int pair, int* u, int* v) {
@@ -151,8 +151,9 @@ void ComponentLabeler::classify_span(const ImageView& frame, int y, int x0, int 
         const uint8_t* uv_other = frame.uv_row(y_other);
         sweep([row](int x) { return row[x]; },
               [uv, uv_other](int pair, int* u, int* v) {
-                *u = 3 * uv[2 * pair] + uv_other[2 * pair];
-                *v = 3 * uv[2 * pair + 1] + uv_other[2 * pair + 1];
+                *u = kChromaOwnWeight * uv[2 * pair] + kChromaNeighbourWeight * uv_other[2 * pair];
+                *v = kChromaOwnWeight * uv[2 * pair + 1] +
+                     kChromaNeighbourWeight * uv_other[2 * pair + 1];
               });
       } else {
         const uint8_t* us = frame.u_row(y);
@@ -161,7 +162,8 @@ void ComponentLabeler::classify_span(const ImageView& frame, int y, int x0, int 
         const uint8_t* vs_other = frame.v_row(y_other);
         sweep([row](int x) { return row[x]; },
               [us, vs, us_other, vs_other](int pair, int* u, int* v) {
-                *u = 3 * us[pair] + us_other[pair], *v = 3 * vs[pair] + vs_other[pair];
+                *u = kChromaOwnWeight * us[pair] + kChromaNeighbourWeight * us_other[pair];
+                *v = kChromaOwnWeight * vs[pair] + kChromaNeighbourWeight * vs_other[pair];
               });
       }
       return;

@@ -4,6 +4,7 @@
 
 #include <cstdlib>
 
+#include "capture/pixel_convert.h"
 #include "pipeline/localizer.h"
 #include "sim/camera_format.h"
 #include "sim/renderer.h"
@@ -36,7 +37,8 @@ int accuracy_frames(int release_frames) {
 
 AccuracyReport run_scenario(const std::string& name, int frames, uint64_t seed,
                             PositioningMode mode, bool filter, const PipelineConfig& config,
-                            PoseSink* also, double rendered_readout_ms, PixelFormat format) {
+                            PoseSink* also, double rendered_readout_ms, PixelFormat format,
+                            bool as_recorded) {
   sim::SceneOptions options{config.layout, config.intrinsics, seed, nullptr};
   auto scenario = sim::make_scenario(name, options, frames, seed);
   if (!scenario.ok()) {
@@ -59,11 +61,19 @@ AccuracyReport run_scenario(const std::string& name, int frames, uint64_t seed,
     info.timestamp_ns = f.timestamp_ns;
     info.has_ground_truth = true;
     info.ground_truth = f.pose;
-    // As the camera hands the frame over (sim/camera_format.h).
-    Image converted;
+    // As the camera hands the frame over (sim/camera_format.h), and as a
+    // recording of it stores it.
+    Image converted, recorded;
     if (format != PixelFormat::kRgb24) converted = sim::convert_rgb(image, format);
+    const Image& camera = format == PixelFormat::kRgb24 ? image : converted;
+    if (as_recorded) {
+      if (auto ok = capture::to_rgb24(camera.view(), &recorded); !ok) {
+        ADD_FAILURE() << ok.error().message;
+        return {};
+      }
+    }
     const Localization& loc =
-        localizer.localize(format == PixelFormat::kRgb24 ? image.view() : converted.view(), info);
+        localizer.localize(as_recorded ? recorded.view() : camera.view(), info);
     accuracy.consume(loc);
     if (also != nullptr) also->consume(loc);
   }

@@ -19,12 +19,15 @@ int accuracy_frames(int release_frames);
 // and localizes them with `config` in `mode`, through the daemon's temporal
 // filter when `filter`; `also` (if given) sees every frame too. The frames
 // are rendered through a rolling shutter of rendered_readout_ms (the moving
-// sets; config.intrinsics.readout_ms is what the localizer is told). Fails the calling test (and
-// returns an empty report) if the scenario cannot be made.
+// sets; config.intrinsics.readout_ms is what the localizer is told), handed
+// over in `format` as a camera would (sim/camera_format.h) and, when
+// `as_recorded`, converted to RGB24 as `ceilposectl record` stores it
+// (capture::to_rgb24) before localizing: a replay of that camera. Fails the
+// calling test (and returns an empty report) if the scenario cannot be made.
 AccuracyReport run_scenario(const std::string& name, int frames, uint64_t seed,
                             PositioningMode mode, bool filter = false,
                             const PipelineConfig& config = PipelineConfig{},
                             PoseSink* also = nullptr, double rendered_readout_ms = 0.0,
-                            PixelFormat format = PixelFormat::kRgb24);
+                            PixelFormat format = PixelFormat::kRgb24, bool as_recorded = false);
 
 }  // namespace ceilpose::testing
