@@ -6,6 +6,7 @@
 #include <numbers>
 
 #include "core/pose.h"
+#include "core/units.h"
 
 namespace ceilpose {
 namespace {
@@ -25,7 +26,7 @@ constexpr double kStepNoiseM = 0.002;
 constexpr double kCentreAgreeM = 0.01;
 // A straight step turning its direction more than this from the segment's
 // ends it.
-constexpr double kStraightBendRad = 10.0 * kPi / 180.0;
+constexpr double kStraightBendRad = 10.0 * kRadPerDeg;
 
 enum class StepKind { kBroken, kOther, kTurning, kStraight };
 
@@ -339,9 +340,9 @@ Result<MountEstimate> estimate_mount(const std::vector<CameraSample>& samples,
   if (m.turned_rad < options.min_turn_rad || m.driven_m < options.min_drive_m) {
     std::string missing;
     if (m.turned_rad < options.min_turn_rad)
-      missing += "turning in place: " + figure("%.0f", m.turned_rad * 180.0 / kPi) + " deg found" +
+      missing += "turning in place: " + figure("%.0f", m.turned_rad * kDegPerRad) + " deg found" +
                  rejected_turns(m.segments) + ", " +
-                 figure("%.0f", options.min_turn_rad * 180.0 / kPi) + " needed";
+                 figure("%.0f", options.min_turn_rad * kDegPerRad) + " needed";
     if (m.driven_m < options.min_drive_m)
       missing += (missing.empty() ? "" : "; ") + std::string("straight drive: ") +
                  figure("%.2f", m.driven_m) + " m found, " + figure("%.2f", options.min_drive_m) +
@@ -382,8 +383,8 @@ Result<MountEstimate> estimate_mount(const std::vector<CameraSample>& samples,
     return make_error("the drive does not determine the mount well enough: offset 1-sigma " +
                       figure("%.2f", 1000.0 * m.sigma_forward_m) + " mm (limit " +
                       figure("%.2f", 1000.0 * options.max_sigma_offset_m) + " mm), yaw 1-sigma " +
-                      figure("%.3f", m.sigma_yaw_rad * 180.0 / kPi) + " deg (limit " +
-                      figure("%.3f", options.max_sigma_yaw_rad * 180.0 / kPi) +
+                      figure("%.3f", m.sigma_yaw_rad * kDegPerRad) + " deg (limit " +
+                      figure("%.3f", options.max_sigma_yaw_rad * kDegPerRad) +
                       " deg); circle RMS " + figure("%.2f", 1000.0 * m.circle_rms_m) + " mm over " +
                       std::to_string(used.size()) + " turn(s) in place, " +
                       std::to_string(straights.size()) +

@@ -5,5 +5,6 @@
 namespace ceilpose {
 
 inline constexpr double kDegPerRad = 180.0 / std::numbers::pi;
+inline constexpr double kRadPerDeg = std::numbers::pi / 180.0;
 
 }  // namespace ceilpose

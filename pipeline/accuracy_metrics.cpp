@@ -3,7 +3,6 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
-#include <numbers>
 
 #include "core/units.h"
 
@@ -12,7 +11,7 @@ namespace {
 
 constexpr double kWithinUnits = 0.05;  // SPEC §6 thesis criterion
 constexpr double kGrossUnits = 0.25;
-constexpr double kGrossYawRad = 5.0 * std::numbers::pi / 180.0;
+constexpr double kGrossYawRad = 5.0 * kRadPerDeg;
 
 // e^T C^-1 e for a 3x3 symmetric covariance; negative when C is singular.
 double nees(const std::array<double, 9>& c, double ex, double ey, double eyaw) {

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <numbers>
 
+#include "core/units.h"
 #include "sim/ceiling_scene.h"
 
 namespace ceilpose::sim {
@@ -98,7 +99,7 @@ std::vector<BoardPose> checkerboard_views(const CameraIntrinsics& camera, const 
   auto next = [&] { return unit(h = mix64(h)); };
   for (int attempt = 0; static_cast<int>(views.size()) < count && attempt < 100000; ++attempt) {
     const double dist = 0.35 + 0.55 * next();
-    const double tilt = (10.0 + 35.0 * next()) * std::numbers::pi / 180.0;
+    const double tilt = (10.0 + 35.0 * next()) * kRadPerDeg;
     const double dir = 2.0 * std::numbers::pi * next();
     const double spin = (next() - 0.5) * 0.6;
     // Board facing the camera (its normal along -z), then tilted and spun.

@@ -5,6 +5,7 @@
 #include <cstdlib>
 #include <numbers>
 
+#include "core/units.h"
 #include "sim/ceiling_scene.h"
 
 namespace ceilpose::sim {
@@ -107,7 +108,7 @@ Result<LaidCeiling> LaidCeiling::parse(const std::string& spec, const CeilingLay
   HandLaidOptions o;
   o.seed = seed;
   std::string rest = spec.substr(prefix.size());
-  double values[2] = {o.sigma_m * 1000.0, o.sigma_yaw_rad * 180.0 / std::numbers::pi};
+  double values[2] = {o.sigma_m * 1000.0, o.sigma_yaw_rad * kDegPerRad};
   for (double& v : values) {
     if (rest.empty()) break;
     if (rest[0] != ':') return make_error("ceiling '" + spec + "': expected ':' after hand-laid");
@@ -119,7 +120,7 @@ Result<LaidCeiling> LaidCeiling::parse(const std::string& spec, const CeilingLay
   }
   if (!rest.empty()) return make_error("ceiling '" + spec + "': unexpected '" + rest + "'");
   o.sigma_m = values[0] / 1000.0;
-  o.sigma_yaw_rad = values[1] * std::numbers::pi / 180.0;
+  o.sigma_yaw_rad = values[1] * kRadPerDeg;
   return hand_laid(layout, o);
 }
 

@@ -6,6 +6,7 @@
 #include <numbers>
 #include <vector>
 
+#include "core/units.h"
 #include "sim/ceiling_scene.h"
 #include "sim/trajectory.h"
 #include "sim/visibility.h"
@@ -14,7 +15,6 @@ namespace ceilpose::sim {
 namespace {
 
 constexpr double kPi = std::numbers::pi;
-constexpr double kDeg = kPi / 180.0;
 // Rejection-sampling budget per frame of the `edges` set.
 constexpr int kEdgeAttempts = 2000;
 
@@ -146,7 +146,7 @@ void stress(Context& c, Effects& e) {
 
 Result<ScenarioFrame> tilt(Context& c) {
   ScenarioFrame f = at(c.random_pose());
-  const double tilt_rad = c.rng(0.0, 3.0) * kDeg;
+  const double tilt_rad = c.rng(0.0, 3.0) * kRadPerDeg;
   const double dir_rad = c.rng(-kPi, kPi);
   f.mount.tilt_x_rad = tilt_rad * std::cos(dir_rad);
   f.mount.tilt_y_rad = tilt_rad * std::sin(dir_rad);
@@ -197,7 +197,7 @@ Result<ScenarioFrame> walk(Context& c, const Lane* lanes, size_t lane_count) {
   const double g = c.options.layout.grid_m;
   const double heading = std::atan2(l.y1 - l.y0, l.x1 - l.x0);
   ScenarioFrame fr = at({(l.x0 + f * (l.x1 - l.x0)) * g, (l.y0 + f * (l.y1 - l.y0)) * g,
-                         wrap_angle_rad(heading + 25.0 * kDeg * std::sin(7.0 * s))});
+                         wrap_angle_rad(heading + 25.0 * kRadPerDeg * std::sin(7.0 * s))});
   fr.effects.read_noise_sigma = 2.0;
   return fr;
 }
@@ -238,7 +238,7 @@ Result<ScenarioFrame> survey_two_passes(Context& c) {
 Result<ScenarioFrame> mount_drive(Context& c) {
   const double g = c.options.layout.grid_m;
   const double f = (c.index + 0.5) / c.frame_count;
-  const double x0 = 2.5 * g, y0 = 3.0 * g, turn1 = 400.0 * kDeg, run_m = 1.2;
+  const double x0 = 2.5 * g, y0 = 3.0 * g, turn1 = 400.0 * kRadPerDeg, run_m = 1.2;
   Pose2D p{x0, y0, 0.0};
   if (f < 0.45) {
     p.yaw_rad = turn1 * f / 0.45;

@@ -8,7 +8,6 @@
 #include <cstdio>
 #include <map>
 #include <memory>
-#include <numbers>
 #include <numeric>
 
 #include "core/units.h"
@@ -209,7 +208,7 @@ int count_groups(const std::vector<Sighting>& home, int codes) {
 // Frames closer than this in position and yaw see the ceiling alike: one
 // viewpoint.
 constexpr double kViewpointM = 0.05;
-constexpr double kViewpointRad = 5.0 * std::numbers::pi / 180.0;
+constexpr double kViewpointRad = 5.0 * kRadPerDeg;
 
 // Distinct viewpoints among the frames with a used sighting (greedy: a
 // frame far from every viewpoint so far is a new one).
