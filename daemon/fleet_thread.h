@@ -31,6 +31,8 @@ class FleetThread {
   // Idempotent; marks the segment stopped.
   void stop();
   const std::string& segment_name() const { return writer_.name(); }
+  // What other processes did to the segment; the writer repaired it. Any thread.
+  shm::SegmentDamage damage() const { return {writer_.truncations(), writer_.header_repairs()}; }
   uint32_t robots() const { return writer_.robots(); }
 
  private:

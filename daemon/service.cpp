@@ -46,6 +46,23 @@ constexpr int64_t kPrintPeriodNs = 100 * kMsNs;  // --print-poses: at most 10 li
 // How soon a queued READY=1/RELOADING=1/STOPPING=1 is offered to systemd again.
 constexpr int64_t kQueuedRetryMs = 50;
 
+// What another process (the segment owner's user or root) did to a
+// segment, as counted by its writer, when it differs from what was reported.
+void report_damage(const std::string& what, const std::string& name, const shm::SegmentDamage& now,
+                   shm::SegmentDamage* reported) {
+  if (now.truncations != reported->truncations)
+    spdlog::error(
+        "shared memory: {} was truncated by another process (its owner's user or root); grown "
+        "back to its size, {} times so far; readers re-attach",
+        what, now.truncations);
+  if (now.header_repairs != reported->header_repairs)
+    spdlog::error(
+        "shared memory: the header of {} was overwritten by another process (its owner's "
+        "user or root); restored, {} times so far",
+        name, now.header_repairs);
+  *reported = now;
+}
+
 // The configured source options at the calibrated frame size.
 capture::SourceOptions source_options(const ServiceConfig& c) {
   capture::SourceOptions o = c.capture.device;
@@ -137,8 +154,7 @@ class Service {
   std::unique_ptr<capture::CaptureThread> capture_;
   std::optional<ShmPoseWriter> shm_;
   // Counts already logged by report_interference().
-  uint64_t reported_header_repairs_ = 0;
-  uint64_t reported_truncations_ = 0;
+  shm::SegmentDamage shm_damage_, fleet_damage_;  // reported so far
   size_t reported_other_writers_ = 0;
   std::optional<ShmPoseSink> shm_sink_;
   std::optional<DdsPosePublisher> dds_;
@@ -431,20 +447,11 @@ void Service::report_interference() {
       spdlog::info("DDS: {} has no other writer any more", dds_->pose_topic());
     }
   }
-  if (shm_ && shm_->truncations() != reported_truncations_) {
-    reported_truncations_ = shm_->truncations();
-    spdlog::error(
-        "shared memory: {} (or its -wake companion) was truncated by another process (its "
-        "owner's user or root); grown back to its size, {} times so far; readers re-attach",
-        shm_->name(), reported_truncations_);
-  }
-  if (shm_ && shm_->header_repairs() != reported_header_repairs_) {
-    reported_header_repairs_ = shm_->header_repairs();
-    spdlog::error(
-        "shared memory: the header of {} was overwritten by another process (its owner's "
-        "user or root); restored, {} times so far",
-        shm_->name(), reported_header_repairs_);
-  }
+  if (shm_)
+    report_damage(shm_->name() + " (or its -wake companion)", shm_->name(),
+                  {shm_->truncations(), shm_->header_repairs()}, &shm_damage_);
+  if (fleet_)
+    report_damage(fleet_->segment_name(), fleet_->segment_name(), fleet_->damage(), &fleet_damage_);
 }
 
 void Service::reload() {

@@ -48,6 +48,13 @@ std::string wake_segment_name(const std::string& name);
 // which kills the process unless handled; map_shared() installs a handler
 // (once per process, chaining to any handler installed before it) that
 // repairs a fault inside a registered mapping and returns:
+// What other processes (the owner's user or root) did to a live segment
+// and its writer repaired, counted since creation.
+struct SegmentDamage {
+  uint64_t truncations = 0;     // found shrunk and grown back
+  uint64_t header_repairs = 0;  // header found overwritten and restored
+};
+
 enum class OnShrink {
   kRegrow,  // the writer: ftruncate(2) the file back to the mapped size; the
             // access then lands on fresh zero pages, which the writer refills

@@ -4,6 +4,7 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <atomic>
 #include <new>
 #include <vector>
 
@@ -51,15 +52,61 @@ std::atomic<uint64_t>* counter_word(FleetHeader* h, FleetCounter c) {
 
 std::string fleet_segment_name(const std::string& shm_name) { return shm_name + shm::kFleetSuffix; }
 
+// The header fields written once at creation, as the writer keeps them.
+struct FleetIdentity {
+  uint32_t abi_version = 0, header_size = 0, capacity = 0, slot_size = 0, stale_after_ms = 0;
+  uint64_t segment_size = 0, generation = 0;
+  int32_t writer_pid = 0;
+  int64_t start_mono_ns = 0, start_real_ns = 0;
+
+  static FleetIdentity of(const FleetHeader& h) {
+    return {h.abi_version,  h.header_size, h.capacity,   h.slot_size,     h.stale_after_ms,
+            h.segment_size, h.generation,  h.writer_pid, h.start_mono_ns, h.start_real_ns};
+  }
+  bool operator==(const FleetIdentity&) const = default;
+};
+
 struct ShmFleetWriter::Impl {
   std::string name;
   UniqueFd fd;  // holds the flock that marks a live writer
   shm::Mapping mapping;
   FleetHeader* header = nullptr;
+  FleetIdentity identity;
+  WriterState state = WriterState::kStarting;
   std::vector<uint8_t> used;  // per slot, sized once
   uint32_t robots = 0;
   uint32_t slots_used = 0;
   bool stopped = false;
+  std::atomic<uint64_t> header_repairs{0};
+
+  // Puts the header back if another process overwrote it (or a truncation
+  // zeroed it): new readers would say "bad magic" forever. Magic last, as
+  // at creation.
+  void restore_header() {
+    FleetHeader& h = *header;
+    const bool intact = h.magic.load(std::memory_order_acquire) == shm::kFleetMagic &&
+                        FleetIdentity::of(h) == identity &&
+                        h.state.load(std::memory_order_relaxed) == static_cast<uint32_t>(state) &&
+                        h.robots.load(std::memory_order_relaxed) == robots &&
+                        h.slots_used.load(std::memory_order_relaxed) == slots_used;
+    if (intact) return;
+    h.magic.store(0, std::memory_order_release);
+    h.abi_version = identity.abi_version;
+    h.header_size = identity.header_size;
+    h.segment_size = identity.segment_size;
+    h.capacity = identity.capacity;
+    h.slot_size = identity.slot_size;
+    h.writer_pid = identity.writer_pid;
+    h.stale_after_ms = identity.stale_after_ms;
+    h.generation = identity.generation;
+    h.start_mono_ns = identity.start_mono_ns;
+    h.start_real_ns = identity.start_real_ns;
+    h.state.store(static_cast<uint32_t>(state), std::memory_order_relaxed);
+    h.robots.store(robots, std::memory_order_relaxed);
+    h.slots_used.store(slots_used, std::memory_order_relaxed);
+    h.magic.store(shm::kFleetMagic, std::memory_order_release);
+    header_repairs.fetch_add(1, std::memory_order_relaxed);
+  }
 
   ~Impl() {
     if (header != nullptr && !stopped) {
@@ -118,6 +165,7 @@ Result<ShmFleetWriter> ShmFleetWriter::create(const ShmFleetOptions& options, Sh
   h->heartbeat_mono_ns.store(h->start_mono_ns, std::memory_order_relaxed);
   h->magic.store(shm::kFleetMagic, std::memory_order_release);
   impl->header = h;
+  impl->identity = FleetIdentity::of(*h);
   impl->fd = std::move(fd).value();
   impl->mapping = std::move(mapping).value();
   cleanup.armed = false;
@@ -178,10 +226,12 @@ uint64_t ShmFleetWriter::counted(FleetCounter counter) const {
 uint32_t ShmFleetWriter::robots() const { return impl_->robots; }
 
 void ShmFleetWriter::heartbeat() {
+  impl_->restore_header();
   impl_->header->heartbeat_mono_ns.store(monotonic_ns(), std::memory_order_release);
 }
 
 void ShmFleetWriter::mark_running() {
+  impl_->state = WriterState::kRunning;
   impl_->header->state.store(static_cast<uint32_t>(WriterState::kRunning),
                              std::memory_order_release);
   heartbeat();
@@ -189,6 +239,7 @@ void ShmFleetWriter::mark_running() {
 
 void ShmFleetWriter::mark_stopped() {
   heartbeat();
+  impl_->state = WriterState::kStopped;
   impl_->header->state.store(static_cast<uint32_t>(WriterState::kStopped),
                              std::memory_order_release);
   impl_->stopped = true;
@@ -196,5 +247,8 @@ void ShmFleetWriter::mark_stopped() {
 
 const std::string& ShmFleetWriter::name() const { return impl_->name; }
 uint64_t ShmFleetWriter::truncations() const { return impl_->mapping.regrown(); }
+uint64_t ShmFleetWriter::header_repairs() const {
+  return impl_->header_repairs.load(std::memory_order_relaxed);
+}
 
 }  // namespace ceilpose

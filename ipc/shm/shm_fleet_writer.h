@@ -56,6 +56,8 @@ class ShmFleetWriter {
   void count(FleetCounter counter, uint64_t n = 1);
   uint64_t counted(FleetCounter counter) const;
   uint32_t robots() const;
+  // Refreshes the heartbeat, and first restores the header (identity, state,
+  // robot counts) if another process overwrote it or a truncation zeroed it.
   void heartbeat();
   // State "running" once the keeper runs, "stopped" when the daemon stops.
   void mark_running();
@@ -63,6 +65,8 @@ class ShmFleetWriter {
   const std::string& name() const;
   // Times the segment was found truncated (SIGBUS) and grown back.
   uint64_t truncations() const;
+  // Times heartbeat() found the header overwritten and restored it. Any thread.
+  uint64_t header_repairs() const;
 
  private:
   struct Impl;

@@ -1,13 +1,16 @@
 // ceilposed as systemd runs it: a child process with a NOTIFY_SOCKET the test
 // owns and WATCHDOG_USEC set, on the synthetic source, a unique shared-memory
 // name and DDS off.
+#include <fcntl.h>
 #include <gtest/gtest.h>
 #include <signal.h>
+#include <sys/mman.h>
 #include <unistd.h>
 
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <map>
@@ -17,6 +20,7 @@
 
 #include "core/exit_codes.h"
 #include "daemon/systemd_notifier.h"
+#include "ipc/shm/shm_fleet_reader.h"
 #include "ipc/shm/shm_pose_reader.h"
 #include "ipc/shm/shm_pose_writer.h"
 #include "pipeline/accuracy_metrics.h"
@@ -261,6 +265,41 @@ TEST_F(DaemonLifecycle, AReloadIsAnnouncedOnceASlowNotifyReaderReadsAgain) {
   const auto exit = daemon->wait(5000);
   ASSERT_TRUE(exit.has_value()) << daemon->err();
   EXPECT_EQ(exit->code, ceilpose::kExitOk) << daemon->err();
+}
+
+// The fleet segment, scribbled over by its owner's user or root: the
+// daemon's fleet writer restores the header at its next heartbeat (20 ms),
+// the daemon says so, and a controller opens it again.
+TEST_F(DaemonLifecycle, AnOverwrittenFleetHeaderIsRestoredAndLogged) {
+  test::use_loopback_dds();
+  std::string with_dds = config_text();
+  with_dds.replace(with_dds.find("dds:\n  enabled: false"),
+                   std::string("dds:\n  enabled: false").size(), "dds:\n  enabled: true");
+  { std::ofstream(config_) << with_dds; }
+  auto daemon = start({"--domain", std::to_string(test::unique_domain_id()), "--robot",
+                       test::unique_robot_name("fleet")});
+  ASSERT_TRUE(notify_.wait_for("READY=1", kStartTimeoutMs)) << daemon->err();
+  const std::string fleet = shm_ + "-fleet";
+  const auto before = ShmFleetReader::open(shm_);
+  ASSERT_TRUE(before.ok()) << before.error().message << daemon->err();
+  {
+    const int fd = ::shm_open(fleet.c_str(), O_RDWR, 0);
+    ASSERT_GE(fd, 0) << fleet;
+    void* p = ::mmap(nullptr, 64, PROT_READ | PROT_WRITE, MAP_SHARED, fd, 0);
+    ASSERT_NE(p, MAP_FAILED);
+    std::memset(p, 0x5a, 64);
+    ::munmap(p, 64);
+    ::close(fd);
+  }
+  daemon->read_error_until("was overwritten by another process", 5000);
+  EXPECT_NE(daemon->err().find("shared memory: the header of " + fleet +
+                               " was overwritten by another process"),
+            std::string::npos)
+      << daemon->err();
+  const auto after = ShmFleetReader::open(shm_);
+  EXPECT_TRUE(after.ok()) << after.error().message;
+  daemon->signal(SIGTERM);
+  ASSERT_TRUE(daemon->wait(5000).has_value()) << daemon->err();
 }
 
 // Issue 15: truncate(1) of the live segment (its owner's user or root) used

@@ -135,6 +135,51 @@ TEST(FleetSegment, ReadersCallARobotStaleWhenNothingCameForItsLimitWhateverTheKe
   EXPECT_TRUE(ShmFleetWriter::remove(w.name()).ok());
 }
 
+// Garbage over a live fleet segment's header, or truncate(1) (its owner's
+// user or root): controllers' new opens said "bad magic" or "too small"
+// for as long as the daemon ran. The writer's heartbeat restores the header
+// and counts it, as the pose segment's writer does.
+TEST(FleetSegment, TheWriterRestoresAnOverwrittenOrTruncatedHeaderAndCountsIt) {
+  const std::string shm = test::unique_fleet_shm();
+  ShmFleetWriter w = make_writer(shm);
+  w.mark_running();
+  shm::FleetRecord robot{};
+  std::strcpy(robot.robot, "r1");
+  robot.pose = test::moving_pose(realtime_ns(), 1.0);
+  robot.received_mono_ns = monotonic_ns();
+  w.store(0, robot);
+
+  const std::string name = fleet_segment_name(shm);
+  const int fd = ::shm_open(name.c_str(), O_RDWR, 0);
+  ASSERT_GE(fd, 0);
+  void* p = ::mmap(nullptr, sizeof(shm::FleetHeader), PROT_READ | PROT_WRITE, MAP_SHARED, fd, 0);
+  ASSERT_NE(p, MAP_FAILED);
+  std::memset(p, 0x5a, sizeof(shm::FleetHeader));
+  ::munmap(p, sizeof(shm::FleetHeader));
+  EXPECT_FALSE(ShmFleetReader::open(shm).ok()) << "the scribble must break the header";
+  w.heartbeat();
+  EXPECT_EQ(w.header_repairs(), 1u);
+  auto reader = ShmFleetReader::open(shm);
+  ASSERT_TRUE(reader.ok()) << reader.error().message;
+  shm::FleetRecord out[2];
+  ASSERT_EQ(reader->read(0, out, 2), 1u) << "slots and counts as the writer keeps them";
+  EXPECT_STREQ(out[0].robot, "r1");
+  w.heartbeat();
+  EXPECT_EQ(w.header_repairs(), 1u) << "an intact header is not repaired";
+
+  ASSERT_EQ(::ftruncate(fd, 0), 0);
+  ::close(fd);
+  w.store(0, robot);  // the keeper's next sample: grows the file back
+  w.heartbeat();
+  EXPECT_EQ(w.truncations(), 1u);
+  EXPECT_EQ(w.header_repairs(), 2u);
+  auto again = ShmFleetReader::open(shm);
+  ASSERT_TRUE(again.ok()) << again.error().message;
+  ASSERT_EQ(again->read(0, out, 2), 1u);
+  EXPECT_STREQ(out[0].robot, "r1");
+  EXPECT_TRUE(ShmFleetWriter::remove(w.name()).ok());
+}
+
 TEST(FleetSegment, AControllersReadAndTheKeepersKnownRobotAllocateNothing) {
   const std::string shm = test::unique_fleet_shm();
   ShmFleetWriter w = make_writer(shm, 64);
