@@ -32,7 +32,7 @@ Result<void> SyntheticSource::do_open() {
     return make_error("synthetic: camera size must be positive, got " + std::to_string(k.width) +
                       "x" + std::to_string(k.height));
   }
-  pool_.resize(std::max(2, options_.buffer_count), k.width, k.height, PixelFormat::kRgb24);
+  pool_.resize(std::max(2, options_.buffer_count), k.width, k.height, generator_->format());
   period_ns_ = static_cast<int64_t>(std::llround(1e9 / options_.fps));
   return {};
 }

@@ -18,7 +18,9 @@ class FrameGenerator {
   virtual ~FrameGenerator() = default;
   // Size and lens of the images (fixed for the generator's life).
   virtual const CameraIntrinsics& intrinsics() const = 0;
-  // Renders into `out` (RGB24, intrinsics' size, already allocated by the
+  // The pixel format of the images, as a camera hands them over.
+  virtual PixelFormat format() const { return PixelFormat::kRgb24; }
+  // Renders into `out` (format(), intrinsics' size, already allocated by the
   // caller) the view at `elapsed_ns` since the start; `tick` numbers the
   // camera's exposures (noise seeds). Called from one thread; no allocation.
   virtual void generate(int64_t elapsed_ns, uint64_t tick, Image* out, Pose2D* ground_truth) = 0;

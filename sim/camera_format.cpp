@@ -22,9 +22,8 @@ uint8_t chroma_v(double r, double g, double b) {
 
 // 4:2:0: luma per pixel, U and V of each 2x2 block's mean colour, in the
 // layouts of core/image.h.
-Image convert_yuv420(const Image& rgb, PixelFormat format) {
+void convert_yuv420(const Image& rgb, PixelFormat format, Image& out) {
   const int w = rgb.width(), h = rgb.height();
-  Image out(w, h, format);
   const ImageView view = out.view();
   for (int y = 0; y < h; ++y) {
     const uint8_t* s = rgb.data() + static_cast<size_t>(y) * rgb.stride_bytes();
@@ -51,14 +50,22 @@ Image convert_yuv420(const Image& rgb, PixelFormat format) {
       }
     }
   }
-  return out;
 }
 
 }  // namespace
 
 Image convert_rgb(const Image& rgb, PixelFormat format) {
-  if (is_yuv420(format)) return convert_yuv420(rgb, format);
-  Image out(rgb.width(), rgb.height(), format);
+  Image out;
+  convert_rgb(rgb, format, &out);
+  return out;
+}
+
+void convert_rgb(const Image& rgb, PixelFormat format, Image* out_image) {
+  if (out_image->width() != rgb.width() || out_image->height() != rgb.height() ||
+      out_image->format() != format)
+    out_image->resize(rgb.width(), rgb.height(), format);
+  Image& out = *out_image;
+  if (is_yuv420(format)) return convert_yuv420(rgb, format, out);
   for (int y = 0; y < rgb.height(); ++y) {
     const uint8_t* s = rgb.data() + static_cast<size_t>(y) * rgb.stride_bytes();
     uint8_t* d = out.row(y);
@@ -94,7 +101,6 @@ Image convert_rgb(const Image& rgb, PixelFormat format) {
       }
     }
   }
-  return out;
 }
 
 }  // namespace ceilpose::sim

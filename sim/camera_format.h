@@ -10,5 +10,8 @@
 namespace ceilpose::sim {
 
 Image convert_rgb(const Image& rgb, PixelFormat format);
+// The same into `out`, which is resized (allocating) only when its size or
+// format differ: the synthetic camera converts every frame so.
+void convert_rgb(const Image& rgb, PixelFormat format, Image* out);
 
 }  // namespace ceilpose::sim

@@ -16,6 +16,9 @@ struct TrajectoryCameraOptions {
   CameraMount mount;
   Effects effects;
   double trajectory_start_s = 0.0;  // time along trajectory_pose of the first frame
+  // As the camera hands frames over (sim/camera_format.h): RGB24, or YUYV,
+  // NV12, ... converted from the render.
+  PixelFormat format = PixelFormat::kRgb24;
 };
 
 class TrajectoryCamera final : public FrameGenerator {
@@ -23,12 +26,14 @@ class TrajectoryCamera final : public FrameGenerator {
   explicit TrajectoryCamera(const TrajectoryCameraOptions& options);
 
   const CameraIntrinsics& intrinsics() const override { return options_.scene.intrinsics; }
+  PixelFormat format() const override { return options_.format; }
   void generate(int64_t elapsed_ns, uint64_t tick, Image* out, Pose2D* ground_truth) override;
   std::string describe() const override;
 
  private:
   TrajectoryCameraOptions options_;
   Renderer renderer_;
+  Image rendered_;  // the RGB render of a frame in another format, sized once
 };
 
 }  // namespace ceilpose::sim

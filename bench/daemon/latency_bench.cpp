@@ -1,7 +1,8 @@
 // End-to-end latency of ceilposed's frame path, frame ready (dequeued by the
 // capture thread) to pose published on shared memory, using the daemon's own
 // PipelineWorker: synthetic and replay sources at 30, 60 and 120 fps, 640x480,
-// with the other core idle or busy (a spinning thread pinned to it).
+// with the other core idle or busy (a spinning thread pinned to it); the
+// synthetic camera in RGB24 or, as USB cameras deliver, YUYV (yuyv:1).
 //
 // Each case runs for --duration_s seconds (default 2) of wall time; the figures
 // are counters: p50/p99/max in microseconds, frames, and the frames skipped or
@@ -94,6 +95,8 @@ std::string replay_dir() {
 void BM_FrameToPose(benchmark::State& state, bool replay) {
   const double fps = static_cast<double>(state.range(0));
   const bool loaded = state.range(1) != 0;
+  // The synthetic camera hands over YUYV, as a USB camera does (issue 29).
+  const bool yuyv = !replay && state.range(2) != 0;
 
   ServiceConfig config = default_config();
   config.capture.device.fps = fps;
@@ -104,6 +107,7 @@ void BM_FrameToPose(benchmark::State& state, bool replay) {
   sim::TrajectoryCameraOptions camera;
   camera.scene = sim::SceneOptions{config.pipeline.layout, config.pipeline.intrinsics, 1, nullptr};
   camera.mount = config.pipeline.mount;
+  if (yuyv) camera.format = PixelFormat::kYuyv;
   if (replay) {
     spec = "replay:" + replay_dir();
     so.replay_speed = fps / 30.0;  // the recording is 30 fps
@@ -172,12 +176,13 @@ void BM_FrameToPose(benchmark::State& state, bool replay) {
 void register_all() {
   for (bool replay : {false, true}) {
     const char* name = replay ? "replay" : "synthetic";
-    benchmark::RegisterBenchmark(name, [replay](benchmark::State& s) { BM_FrameToPose(s, replay); })
-        ->ArgsProduct({{30, 60, 120}, {0, 1}})
-        ->ArgNames({"fps", "load"})
-        ->Iterations(1)
-        ->UseManualTime()
-        ->Unit(benchmark::kMillisecond);
+    auto* b = benchmark::RegisterBenchmark(
+        name, [replay](benchmark::State& s) { BM_FrameToPose(s, replay); });
+    if (replay)
+      b->ArgsProduct({{30, 60, 120}, {0, 1}})->ArgNames({"fps", "load"});
+    else
+      b->ArgsProduct({{30, 60, 120}, {0, 1}, {0, 1}})->ArgNames({"fps", "load", "yuyv"});
+    b->Iterations(1)->UseManualTime()->Unit(benchmark::kMillisecond);
   }
 }
 

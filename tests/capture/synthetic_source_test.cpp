@@ -5,8 +5,10 @@
 #include <gtest/gtest.h>
 
 #include <chrono>
+#include <cstring>
 #include <thread>
 
+#include "sim/camera_format.h"
 #include "sim/trajectory.h"
 #include "sim/trajectory_camera.h"
 
@@ -189,6 +191,34 @@ TEST(SyntheticSource, ANonPositiveFrameRateFailsInOpen) {
   auto r = source.open();
   ASSERT_FALSE(r);
   EXPECT_NE(r.error().message.find("frame rate"), std::string::npos) << r.error().message;
+}
+
+// A synthetic USB camera (issue 29): frames handed over in YUYV, converted
+// from the same render as a camera's ISP would (sim/camera_format.h), so
+// latency_bench and the daemon's path see the camera's own format.
+TEST(SyntheticSource, AYuyvCameraHandsOverTheSameSceneInYuyv) {
+  sim::TrajectoryCameraOptions o = small_scene();
+  sim::TrajectoryCamera rgb_camera(o);
+  o.format = PixelFormat::kYuyv;
+  auto yuyv_camera = std::make_shared<sim::TrajectoryCamera>(o);
+  EXPECT_EQ(yuyv_camera->format(), PixelFormat::kYuyv);
+  Image rgb(160, 120, PixelFormat::kRgb24), yuyv(160, 120, PixelFormat::kYuyv);
+  Pose2D a, b;
+  rgb_camera.generate(0, 0, &rgb, &a);
+  yuyv_camera->generate(0, 0, &yuyv, &b);
+  const Image expected = sim::convert_rgb(rgb, PixelFormat::kYuyv);
+  ASSERT_EQ(yuyv.stride_bytes(), 2 * 160);
+  EXPECT_EQ(std::memcmp(yuyv.data(), expected.data(), 2 * 160 * 120), 0);
+
+  SyntheticSource source(at_rate(200.0), yuyv_camera);
+  ASSERT_TRUE(source.open());
+  ASSERT_TRUE(source.start());
+  Frame f;
+  ASSERT_TRUE(wait_frame(source, &f));
+  EXPECT_EQ(f.image.format, PixelFormat::kYuyv);
+  EXPECT_EQ(f.image.stride_bytes, 2 * 160);
+  source.release(f);
+  source.stop();
 }
 
 }  // namespace
