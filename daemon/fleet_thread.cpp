@@ -62,21 +62,36 @@ void FleetThread::start() {
 
 void FleetThread::stop() {
   stop_.store(true, std::memory_order_release);
-  if (thread_.joinable()) {
-    thread_.join();
+  const bool was_running = thread_.joinable();
+  if (was_running) thread_.join();
+  // No listener may call the keeper once this returns.
+  subscriber_.stop_listening();
+  if (was_running) {
+    const std::lock_guard lock(mutex_);
     writer_.mark_stopped();
   }
+}
+
+void FleetThread::LockedKeeper::on_sample(const FleetSample& sample) {
+  const std::lock_guard lock(*mutex_);
+  keeper_->on_sample(sample);
+}
+
+void FleetThread::LockedKeeper::on_problem(const std::string& message) {
+  const std::lock_guard lock(*mutex_);
+  keeper_->on_problem(message);
 }
 
 void FleetThread::run() {
   ::pthread_setname_np(::pthread_self(), "fleet");
   bool failed = false;
   while (!stop_.load(std::memory_order_acquire)) {
-    if (auto ok = subscriber_.poll(kPollMs, &keeper_); !ok && !failed) {
+    if (auto ok = subscriber_.poll(kPollMs, &locked_keeper_); !ok && !failed) {
       // Reported once: a DDS error here repeats every pass.
       spdlog::error("{}", ok.error().message);
       failed = true;
     }
+    const std::lock_guard lock(mutex_);
     keeper_.sweep(monotonic_ns());
     writer_.heartbeat();
   }

@@ -1,13 +1,15 @@
 #pragma once
-// The daemon's fleet: a thread of normal priority that listens to the other
-// robots' states on DDS (DdsFleetSubscriber), lets the FleetKeeper decide
-// what reaches <shm>-fleet, ages robots out and keeps the segment's
-// heartbeat. It shares the publisher's DDS participant and must stop before
-// that participant goes.
+// The daemon's fleet: the other robots' states on DDS (DdsFleetSubscriber)
+// go to the FleetKeeper, which decides what reaches <shm>-fleet, as they
+// arrive (in DDS's receive threads); a thread of normal priority discovers
+// robots, ages them out and keeps the segment's heartbeat. One mutex
+// serialises the keeper and the writer between them. It shares the
+// publisher's DDS participant and must stop before that participant goes.
 #include <dds/dds.h>
 
 #include <atomic>
 #include <memory>
+#include <mutex>
 #include <optional>
 #include <thread>
 
@@ -39,9 +41,23 @@ class FleetThread {
   FleetThread(ShmFleetWriter writer, DdsFleetSubscriber subscriber, const FleetOptions& options);
   void run();
 
+  // The keeper as DDS's receive threads see it: under mutex_.
+  class LockedKeeper final : public FleetSampleSink {
+   public:
+    LockedKeeper(FleetKeeper* keeper, std::mutex* mutex) : keeper_(keeper), mutex_(mutex) {}
+    void on_sample(const FleetSample& sample) override;
+    void on_problem(const std::string& message) override;
+
+   private:
+    FleetKeeper* keeper_;
+    std::mutex* mutex_;
+  };
+
   ShmFleetWriter writer_;
   DdsFleetSubscriber subscriber_;
+  std::mutex mutex_;  // the keeper and the writer's header
   FleetKeeper keeper_;
+  LockedKeeper locked_keeper_{&keeper_, &mutex_};
   std::atomic<bool> stop_{false};
   std::thread thread_;
 };

@@ -4,6 +4,8 @@
 // harness runs every robot on one host, so the clocks agree), and notes when
 // all --robots robots were first present. At the end prints one line:
 //   robots R present_ms T samples S lost L p50_ms a p99_ms b max_ms c refused F
+// and then, for each robot, when it was first present (CLOCK_MONOTONIC):
+//   first_present ROBOT NS
 #include <time.h>
 #include <unistd.h>
 
@@ -62,6 +64,7 @@ int main(int argc, char** argv) {
   const uint32_t capacity = reader->info().capacity;
   std::vector<shm::FleetRecord> out(capacity);
   std::map<std::string, uint64_t> last_samples;
+  std::map<std::string, int64_t> first_present_ns;
   std::vector<double> latency_ms;
   latency_ms.reserve(1'000'000);
   int64_t present_ns = -1;
@@ -72,6 +75,7 @@ int main(int argc, char** argv) {
     const uint32_t n = reader->read(0, out.data(), capacity);
     if (present_ns < 0 && n >= want) present_ns = now - start_ns;
     for (uint32_t i = 0; i < n; ++i) {
+      first_present_ns.emplace(out[i].robot, now);
       uint64_t& seen = last_samples[out[i].robot];
       if (out[i].samples == seen) continue;
       seen = out[i].samples;
@@ -99,5 +103,7 @@ int main(int argc, char** argv) {
       pct(0.5), pct(0.99), latency_ms.empty() ? NAN : latency_ms.back(),
       static_cast<unsigned long long>(info.refused_full + info.refused_future + info.refused_past +
                                       info.refused_invalid + info.refused_duplicate));
+  for (const auto& [robot, ns] : first_present_ns)
+    std::printf("first_present %s %lld\n", robot.c_str(), static_cast<long long>(ns));
   return 0;
 }

@@ -3,7 +3,8 @@
 // sink (pose, odometry, TF, the fleet's state) at --rate Hz from a circular
 // trajectory with a full motion state, without any image work, so that 50
 // of them fit on two cores. Prints "ready", then at the end one line:
-//   published N cpu_s C rss_kb R
+//   published N cpu_s C rss_kb R failures F started_mono_ns S
+// (S: when the process began, CLOCK_MONOTONIC, for the time it took to join).
 #include <sys/resource.h>
 #include <time.h>
 
@@ -37,6 +38,7 @@ long rss_kb() {
 
 int main(int argc, char** argv) {
   using namespace ceilpose;
+  const int64_t started_mono_ns = monotonic_ns();
   CLI::App app{"One simulated robot of the fleet harness: publishes through the DDS sink."};
   DdsOptions options;
   double rate_hz = 30.0;
@@ -115,9 +117,10 @@ int main(int argc, char** argv) {
   getrusage(RUSAGE_SELF, &ru);
   const double cpu_s = static_cast<double>(ru.ru_utime.tv_sec + ru.ru_stime.tv_sec) +
                        static_cast<double>(ru.ru_utime.tv_usec + ru.ru_stime.tv_usec) * 1e-6;
-  std::printf("published %llu cpu_s %.3f rss_kb %ld failures %llu\n",
+  std::printf("published %llu cpu_s %.3f rss_kb %ld failures %llu started_mono_ns %lld\n",
               static_cast<unsigned long long>(published), cpu_s, rss_kb(),
-              static_cast<unsigned long long>(sink.failures()));
+              static_cast<unsigned long long>(sink.failures()),
+              static_cast<long long>(started_mono_ns));
   std::fflush(stdout);
   publisher->dispose();
   return 0;

@@ -1,6 +1,7 @@
 #include "ipc/dds/dds_fleet_subscriber.h"
 
 #include <array>
+#include <memory>
 #include <utility>
 
 #include "ipc/dds/dds_error.h"
@@ -39,21 +40,46 @@ DdsFleetSubscriber::DdsFleetSubscriber(DdsFleetSubscriber&& other) noexcept
       found_(std::move(other.found_)) {}
 
 DdsFleetSubscriber::~DdsFleetSubscriber() {
-  // Readers and the discovery reader go with the participant; the waitset
-  // is ours to delete while the participant lives.
+  // The listeners point into readers_: they stop before it goes. The
+  // discovery reader goes with the participant; the waitset is ours to
+  // delete while the participant lives.
+  stop_listening();
   if (waitset_ > 0) dds_delete(waitset_);
+}
+
+void DdsFleetSubscriber::stop_listening() {
+  // Deleting a reader waits for its listener calls in progress and makes no
+  // new ones (Cyclone's entity deletion).
+  for (auto& [robot, reader] : readers_) {
+    if (reader.handle > 0) dds_delete(reader.handle);
+  }
+  readers_.clear();
+}
+
+void DdsFleetSubscriber::on_data_available(dds_entity_t reader, void* arg) {
+  const auto* r = static_cast<const Reader*>(arg);
+  if (auto ok = take(*r->robot, reader, r->sink); !ok) r->sink->on_problem(ok.error().message);
 }
 
 Result<void> DdsFleetSubscriber::poll(int64_t timeout_ms, FleetSampleSink* sink) {
   const dds_return_t rc = dds_waitset_wait(waitset_, nullptr, 0, DDS_MSECS(timeout_ms));
   if (rc < 0) return dds_error("fleet: waiting for DDS data failed", rc);
+  if (rc == 0) return {};
   found_.clear();
   if (auto ok = discovery_.take_new(&found_); !ok) return ok;
   for (const DiscoveredTopic& t : found_) {
     if (t.robot == own_robot_ || readers_.contains(t.robot)) continue;
+    const auto it = readers_.try_emplace(t.robot).first;
+    Reader& entry = it->second;
+    entry.robot = &it->first;
+    entry.sink = sink;
+    const std::unique_ptr<dds_listener_t, decltype(&dds_delete_listener)> listener(
+        dds_create_listener(&entry), &dds_delete_listener);
+    dds_lset_data_available(listener.get(), &DdsFleetSubscriber::on_data_available);
     auto reader = create_fleet_reader(participant_, waitset_, &ceilpose_msg_dds__State__desc,
-                                      t.topic, true, depth_);
+                                      t.topic, true, depth_, listener.get());
     if (!reader) {
+      readers_.erase(it);
       // Under DDS Security, access control refuses a reader the permissions
       // do not grant; enclaves made before the fleet existed lack it.
       sink->on_problem(reader.error().message +
@@ -62,10 +88,7 @@ Result<void> DdsFleetSubscriber::poll(int64_t timeout_ms, FleetSampleSink* sink)
                        "`ceilposectl keys add` again)");
       continue;
     }
-    readers_.emplace(t.robot, *reader);
-  }
-  for (const auto& [robot, reader] : readers_) {
-    if (auto ok = take(robot, reader, sink); !ok) return ok;
+    entry.handle = *reader;
   }
   return {};
 }

@@ -71,7 +71,8 @@ Result<void> DdsTopicDiscovery::take_new(std::vector<DiscoveredTopic>* found) {
 
 Result<dds_entity_t> create_fleet_reader(dds_entity_t participant, dds_entity_t waitset,
                                          const dds_topic_descriptor_t* descriptor,
-                                         const std::string& topic, bool reliable, int32_t depth) {
+                                         const std::string& topic, bool reliable, int32_t depth,
+                                         const dds_listener_t* listener) {
   const dds_entity_t t = dds_create_topic(participant, descriptor, topic.c_str(), nullptr, nullptr);
   if (t < 0) return dds_error("cannot create DDS topic " + topic, t);
   DdsQos qos = make_dds_qos();
@@ -85,8 +86,9 @@ Result<dds_entity_t> create_fleet_reader(dds_entity_t participant, dds_entity_t 
   const std::array<dds_data_representation_id_t, 2> representations{DDS_DATA_REPRESENTATION_XCDR1,
                                                                     DDS_DATA_REPRESENTATION_XCDR2};
   dds_qset_data_representation(qos.get(), representations.size(), representations.data());
-  const dds_entity_t reader = dds_create_reader(participant, t, qos.get(), nullptr);
+  const dds_entity_t reader = dds_create_reader(participant, t, qos.get(), listener);
   if (reader < 0) return dds_error("cannot create a reader for " + topic, reader);
+  if (listener != nullptr) return reader;
   dds_return_t rc = dds_set_status_mask(reader, DDS_DATA_AVAILABLE_STATUS);
   if (rc == DDS_RETCODE_OK) rc = dds_waitset_attach(waitset, reader, 0);
   if (rc != DDS_RETCODE_OK) return dds_error("cannot wait for data on " + topic, rc);

@@ -42,10 +42,12 @@ class DdsTopicDiscovery {
 };
 
 // A reader of `topic` for the latest samples: `depth` kept per instance,
-// reliable or best effort, accepting XCDR1 and XCDR2, attached to `waitset`
-// for data. The error names the topic.
+// reliable or best effort, accepting XCDR1 and XCDR2. Its data wakes
+// `waitset`, or, given a `listener`, calls that listener instead (in DDS's
+// receive thread, with no thread to wake). The error names the topic.
 Result<dds_entity_t> create_fleet_reader(dds_entity_t participant, dds_entity_t waitset,
                                          const dds_topic_descriptor_t* descriptor,
-                                         const std::string& topic, bool reliable, int32_t depth);
+                                         const std::string& topic, bool reliable, int32_t depth,
+                                         const dds_listener_t* listener = nullptr);
 
 }  // namespace ceilpose
