@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstring>
+#include <tuple>
 
 #include "core/pixel_read.h"
 
@@ -29,7 +30,72 @@ namespace {
 
 constexpr size_t kRowPadding = 8;
 
+// x86-64's baseline (SSE2) has no 32-bit vector multiply, so the BT.601
+// arithmetic is also compiled for AVX2 and picked at load time where the
+// CPU has it (GCC function multi-versioning; the same plain loop, no
+// intrinsics). arm64's baseline (NEON) multiplies in vectors already.
+#if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__)
+#define CEILPOSE_VECTOR_CLONES [[gnu::target_clones("avx2", "default")]]
+#else
+#define CEILPOSE_VECTOR_CLONES
+#endif
+
 int64_t sum_squares_to(int64_t k) { return k * (k + 1) * (2 * k + 1) / 6; }
+
+// Chroma x4 of `pairs` YUYV pixel pairs from `q` (Y0 U Y1 V each).
+CEILPOSE_VECTOR_CLONES void yuyv_chroma(const uint8_t* __restrict q, int16_t* __restrict u4,
+                                        int16_t* __restrict v4, int pairs) {
+  for (int k = 0; k < pairs; ++k) {
+    u4[k] = static_cast<int16_t>(4 * q[4 * k + 1]);
+    v4[k] = static_cast<int16_t>(4 * q[4 * k + 3]);
+  }
+}
+CEILPOSE_VECTOR_CLONES void yuyv_luma(const uint8_t* __restrict q, int16_t* __restrict luma,
+                                      int n) {
+  for (int i = 0; i < n; ++i) luma[i] = q[2 * i];
+}
+// 4:2:0 chroma x4 of `pairs` pairs: the row's own 3:1 with the neighbouring
+// chroma row's, samples `step` bytes apart (NV12 2, I420 1).
+CEILPOSE_VECTOR_CLONES void planar_chroma(const uint8_t* __restrict near,
+                                          const uint8_t* __restrict far, int step,
+                                          int16_t* __restrict c4, int pairs) {
+  for (int k = 0; k < pairs; ++k)
+    c4[k] = static_cast<int16_t>(kChromaOwnWeight * near[step * k] +
+                                 kChromaNeighbourWeight * far[step * k]);
+}
+CEILPOSE_VECTOR_CLONES void planar_luma(const uint8_t* __restrict q, int16_t* __restrict luma,
+                                        int n) {
+  for (int i = 0; i < n; ++i) luma[i] = q[i];
+}
+
+// Chroma x16 of the 2·pairs pixels of `pairs` pixel pairs, from the pairs'
+// chroma x4 with one pair of margin each side (pair4[0] is the pair before
+// the first): 3:1 with the neighbouring pair on the pixel's side.
+CEILPOSE_VECTOR_CLONES void interpolate_chroma(const int16_t* __restrict pair4,
+                                               int16_t* __restrict px16, int pairs) {
+  for (int k = 0; k < pairs; ++k) {
+    const int own = kChromaOwnWeight * pair4[k + 1];
+    px16[2 * k] = static_cast<int16_t>(own + kChromaNeighbourWeight * pair4[k]);
+    px16[2 * k + 1] = static_cast<int16_t>(own + kChromaNeighbourWeight * pair4[k + 2]);
+  }
+}
+
+// BT.601 (video range) from luma and chroma x16 to 0..255 levels, in ints
+// scaled by 2^12. A function of its own so that the compiler knows the
+// arrays do not overlap and vectorises the loop.
+CEILPOSE_VECTOR_CLONES void bt601_levels(const int16_t* __restrict luma,
+                                         const int16_t* __restrict u16,
+                                         const int16_t* __restrict v16, uint8_t* __restrict r,
+                                         uint8_t* __restrict g, uint8_t* __restrict b, int n) {
+  auto level = [](int v) { return static_cast<uint8_t>(std::clamp(v >> 12, 0, 255)); };
+  for (int i = 0; i < n; ++i) {
+    const int c = 16 * (298 * (luma[i] - 16) + 128);
+    const int d = u16[i] - 16 * 128, e = v16[i] - 16 * 128;
+    r[i] = level(c + 409 * e);
+    g[i] = level(c - 100 * d - 208 * e);
+    b[i] = level(c + 516 * d);
+  }
+}
 
 }  // namespace
 
@@ -71,6 +137,11 @@ void ComponentLabeler::resize(int width_px, int height_px) {
   max_runs_ = std::max(1024, static_cast<int>(pixels * params_.max_runs_per_pixel));
   row_class_.assign(static_cast<size_t>(width_) + kRowPadding, 0);
   row_edge_.assign(static_cast<size_t>(width_) + kRowPadding, 0);
+  const size_t pixels_padded = static_cast<size_t>(width_) + kRowPadding;
+  const size_t pairs_padded = static_cast<size_t>(width_ / 2) + kRowPadding;
+  for (auto* v : {&pair_u_, &pair_v_}) v->assign(pairs_padded, 0);
+  for (auto* v : {&px_y_, &px_u_, &px_v_}) v->assign(pixels_padded, 0);
+  for (auto* v : {&px_r_, &px_g_, &px_b_}) v->assign(pixels_padded, 0);
   runs_.resize(static_cast<size_t>(max_runs_) + 1);
   parent_.resize(runs_.size());
   label_.resize(runs_.size());
@@ -79,6 +150,62 @@ void ComponentLabeler::resize(int width_px, int height_px) {
   window_edge_.resize(runs_.size());
   run_count_ = 0;
   comp_count_ = 0;
+}
+
+void ComponentLabeler::classify_yuv_span(const ImageView& frame, int y, int x0, int x1,
+                                         const ColorClassifier& classifier) {
+  // Chroma interpolated at each pixel as core/pixel_read.h does (the
+  // pair's own chroma 3:1 with the neighbouring pair's on the pixel's side;
+  // 4:2:0 also 3:1 with the neighbouring chroma row), then BT.601 to the
+  // normalisation tables' levels and the fused lookup. In stages, so that
+  // all but the last (four table loads a pixel, as for RGB) are arithmetic
+  // the compiler vectorises; the fused one-loop form cost 3x RGB a pixel.
+  const int last_pair = (frame.width - 1) >> 1;
+  const int p0 = x0 >> 1, p1 = x1 >> 1;
+  // pair_u_[k] holds pair p0 - 1 + k: one pair of margin each side.
+  int16_t* pu = pair_u_.data();
+  int16_t* pv = pair_v_.data();
+  int16_t* py = px_y_.data();
+  const uint8_t* row = frame.row(y);
+  // Pairs p0..p1 are in the frame; the margins are clamped to its edges.
+  const int pairs = p1 - p0 + 1;
+  const int before = std::max(p0 - 1, 0), after = std::min(p1 + 1, last_pair);
+  if (frame.format == PixelFormat::kYuyv) {
+    yuyv_chroma(row + 4 * p0, pu + 1, pv + 1, pairs);
+    yuyv_chroma(row + 4 * before, pu, pv, 1);
+    yuyv_chroma(row + 4 * after, pu + pairs + 1, pv + pairs + 1, 1);
+    yuyv_luma(row + 2 * x0, py + x0, x1 - x0 + 1);
+  } else {
+    const int y_other = chroma_neighbour_row(y, frame.height);
+    const bool nv12 = frame.format == PixelFormat::kNv12;
+    const int step = nv12 ? 2 : 1;
+    const uint8_t* u_near = nv12 ? frame.uv_row(y) : frame.u_row(y);
+    const uint8_t* u_far = nv12 ? frame.uv_row(y_other) : frame.u_row(y_other);
+    const uint8_t* v_near = nv12 ? frame.uv_row(y) + 1 : frame.v_row(y);
+    const uint8_t* v_far = nv12 ? frame.uv_row(y_other) + 1 : frame.v_row(y_other);
+    for (auto [near, far, out] : {std::tuple{u_near, u_far, pu}, std::tuple{v_near, v_far, pv}}) {
+      planar_chroma(near + step * p0, far + step * p0, step, out + 1, pairs);
+      planar_chroma(near + step * before, far + step * before, step, out, 1);
+      planar_chroma(near + step * after, far + step * after, step, out + pairs + 1, 1);
+    }
+    planar_luma(row + x0, py + x0, x1 - x0 + 1);
+  }
+  // Per pixel chroma ×16: even pixels lean on the pair before, odd ones on
+  // the pair after. Pixels 2·p0 .. 2·p1 + 1 (the span and at most one more
+  // each side: the buffers are a pixel wider than the frame).
+  interpolate_chroma(pu, px_u_.data() + 2 * p0, pairs);
+  interpolate_chroma(pv, px_v_.data() + 2 * p0, pairs);
+  bt601_levels(py + x0, px_u_.data() + x0, px_v_.data() + x0, px_r_.data() + x0, px_g_.data() + x0,
+               px_b_.data() + x0, x1 - x0 + 1);
+  const uint8_t* r = px_r_.data();
+  const uint8_t* g = px_g_.data();
+  const uint8_t* b = px_b_.data();
+  const uint8_t* lut = classifier.lut();
+  const uint32_t* tr = classifier.table(0);
+  const uint32_t* tg = classifier.table(1);
+  const uint32_t* tb = classifier.table(2);
+  uint8_t* out = row_class_.data();
+  for (int x = x0; x <= x1; ++x) out[x] = lut[tr[r[x]] | tg[g[x]] | tb[b[x]]];
 }
 
 void ComponentLabeler::classify_span(const ImageView& frame, int y, int x0, int x1,
@@ -99,75 +226,9 @@ void ComponentLabeler::classify_span(const ImageView& frame, int y, int x0, int 
     }
     case PixelFormat::kYuyv:
     case PixelFormat::kNv12:
-    case PixelFormat::kYuv420: {
-      // Chroma interpolated at each pixel (core/pixel_read.h says how and
-      // why), in ints held in registers, scaled by 16 for the two blends.
-      // The sweep carries the previous, own and next pair's chroma, so each
-      // pair's is read once.
-      const uint32_t* tr = classifier.table(0);
-      const uint32_t* tg = classifier.table(1);
-      const uint32_t* tb = classifier.table(2);
-      auto level = [](int v) { return std::clamp(v >> 12, 0, 255); };
-      auto classify = [&](int luma, int u16, int v16) {
-        const int c = 16 * (298 * (luma - 16) + 128);
-        const int d = u16 - 16 * 128, e = v16 - 16 * 128;
-        return lut[tr[level(c + 409 * e)] | tg[level(c - 100 * d - 208 * e)] |
-                   tb[level(c + 516 * d)]];
-      };
-      const int last_pair = (frame.width - 1) >> 1;
-      // chroma4_of(pair): the pair's U and V times 4 (4:2:0: blended 3:1
-      // with the neighbouring chroma row).
-      auto sweep = [&](auto luma_of, auto chroma4_of) {
-        int p = x0 >> 1;
-        int prev_u = 0, prev_v = 0, cur_u = 0, cur_v = 0, next_u = 0, next_v = 0;
-        chroma4_of(std::max(p - 1, 0), &prev_u, &prev_v);
-        chroma4_of(p, &cur_u, &cur_v);
-        for (int x = x0; x <= x1; ++p) {
-          chroma4_of(std::min(p + 1, last_pair), &next_u, &next_v);
-          if ((x & 1) == 0) {
-            out[x] =
-                classify(luma_of(x), kChromaOwnWeight * cur_u + kChromaNeighbourWeight * prev_u,
-                         kChromaOwnWeight * cur_v + kChromaNeighbourWeight * prev_v);
-            ++x;
-          }
-          if (x <= x1) {
-            out[x] =
-                classify(luma_of(x), kChromaOwnWeight * cur_u + kChromaNeighbourWeight * next_u,
-                         kChromaOwnWeight * cur_v + kChromaNeighbourWeight * next_v);
-            ++x;
-          }
-          prev_u = cur_u, prev_v = cur_v, cur_u = next_u, cur_v = next_v;
-        }
-      };
-      // 4:2:0: the chroma row of y and the one it leans towards.
-      const int y_other = chroma_neighbour_row(y, frame.height);
-      if (frame.format == PixelFormat::kYuyv) {
-        sweep([row](int x) { return row[2 * x]; },
-              [row](int pair, int* u, int* v) {
-                *u = 4 * row[4 * pair + 1], *v = 4 * row[4 * pair + 3];
-              });
-      } else if (frame.format == PixelFormat::kNv12) {
-        const uint8_t* uv = frame.uv_row(y);
-        const uint8_t* uv_other = frame.uv_row(y_other);
-        sweep([row](int x) { return row[x]; },
-              [uv, uv_other](int pair, int* u, int* v) {
-                *u = kChromaOwnWeight * uv[2 * pair] + kChromaNeighbourWeight * uv_other[2 * pair];
-                *v = kChromaOwnWeight * uv[2 * pair + 1] +
-                     kChromaNeighbourWeight * uv_other[2 * pair + 1];
-              });
-      } else {
-        const uint8_t* us = frame.u_row(y);
-        const uint8_t* vs = frame.v_row(y);
-        const uint8_t* us_other = frame.u_row(y_other);
-        const uint8_t* vs_other = frame.v_row(y_other);
-        sweep([row](int x) { return row[x]; },
-              [us, vs, us_other, vs_other](int pair, int* u, int* v) {
-                *u = kChromaOwnWeight * us[pair] + kChromaNeighbourWeight * us_other[pair];
-                *v = kChromaOwnWeight * vs[pair] + kChromaNeighbourWeight * vs_other[pair];
-              });
-      }
+    case PixelFormat::kYuv420:
+      classify_yuv_span(frame, y, x0, x1, classifier);
       return;
-    }
     case PixelFormat::kGray8:
     case PixelFormat::kMjpeg:
       std::memset(out + x0, 0, static_cast<size_t>(x1 - x0 + 1));

@@ -88,6 +88,8 @@ class ComponentLabeler {
 
   void classify_span(const ImageView& frame, int y, int x0, int x1,
                      const ColorClassifier& classifier);
+  void classify_yuv_span(const ImageView& frame, int y, int x0, int x1,
+                         const ColorClassifier& classifier);
   bool encode_row(int y, int x0, int x1);
   bool sweep_rows(const ImageView& frame, const ColorClassifier& classifier,
                   std::span<const PixelWindow> windows);
@@ -103,6 +105,12 @@ class ComponentLabeler {
   int run_budget_ = 0;              // this sweep's: max_runs_, or the windows' share
   std::vector<uint8_t> row_class_;  // width + 8 bytes of padding
   std::vector<uint8_t> row_edge_;   // 1: a window's edge inside the frame (tracked sweeps)
+  // A YUV span in stages, each a plain loop the compiler vectorises (SSE2,
+  // NEON): per pair chroma ×4 (one pair of margin each side), per pixel
+  // luma and chroma ×16, then the three normalisation-table indices.
+  std::vector<int16_t> pair_u_, pair_v_;
+  std::vector<int16_t> px_y_, px_u_, px_v_;
+  std::vector<uint8_t> px_r_, px_g_, px_b_;
   std::vector<Run> runs_;
   std::vector<int32_t> parent_;
   std::vector<int32_t> label_;

@@ -2,10 +2,13 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <numbers>
 #include <random>
+#include <vector>
 
+#include "core/pixel_read.h"
 #include "tests/pipeline/detect_scene_support.h"
 
 namespace ceilpose {
@@ -146,6 +149,82 @@ TEST_F(ComponentsTest, NoiseBeyondTheRunBudgetAbandonsTheFrame) {
     for (int x = 0; x < kWidth; ++x) test::put_rgb(&frame, x, y, (rng() & 1) ? kRed : kGreen);
   EXPECT_FALSE(labeler.label(frame.view(), classifier));
   EXPECT_TRUE(labeler.components().empty());
+}
+
+// The BT.601 levels the detector must give pixel (x, y) of a YUV frame,
+// written out pixel by pixel: chroma 3:1 with the neighbouring pair (and,
+// 4:2:0, the neighbouring chroma row), kept at x16, then to 2^12-scaled
+// ints and clamped. The sweep computes the same in vectorised stages.
+Rgb reference_levels(const ImageView& f, int x, int y) {
+  auto chroma4 = [&](int pair, int* u, int* v) {
+    if (f.format == PixelFormat::kYuyv) {
+      *u = 4 * f.row(y)[4 * pair + 1], *v = 4 * f.row(y)[4 * pair + 3];
+      return;
+    }
+    const int yo = chroma_neighbour_row(y, f.height);
+    const bool nv12 = f.format == PixelFormat::kNv12;
+    const int un = nv12 ? f.uv_row(y)[2 * pair] : f.u_row(y)[pair];
+    const int uf = nv12 ? f.uv_row(yo)[2 * pair] : f.u_row(yo)[pair];
+    const int vn = nv12 ? f.uv_row(y)[2 * pair + 1] : f.v_row(y)[pair];
+    const int vf = nv12 ? f.uv_row(yo)[2 * pair + 1] : f.v_row(yo)[pair];
+    *u = 3 * un + uf, *v = 3 * vn + vf;
+  };
+  int u_own = 0, v_own = 0, u_nb = 0, v_nb = 0;
+  chroma4(x / 2, &u_own, &v_own);
+  chroma4(chroma_neighbour_pair(x, f.width), &u_nb, &v_nb);
+  const int luma = f.format == PixelFormat::kYuyv ? f.row(y)[2 * x] : f.row(y)[x];
+  const int c = 16 * (298 * (luma - 16) + 128);
+  const int d = 3 * u_own + u_nb - 2048, e = 3 * v_own + v_nb - 2048;
+  auto level = [](int v) { return static_cast<uint8_t>(std::clamp(v >> 12, 0, 255)); };
+  return {level(c + 409 * e), level(c - 100 * d - 208 * e), level(c + 516 * d)};
+}
+
+// Every pixel of a noisy YUV frame (saturated and clamped levels included)
+// is classified as its reference levels are: the components of the YUV
+// frame, swept whole and in windows on odd columns, equal those of the RGB
+// frame made of the reference levels, to the last bit.
+TEST_F(ComponentsTest, YuvFramesClassifyEveryPixelAsItsBt601LevelsDo) {
+  fill(10, 20, 29, 59, kRed);
+  fill(61, 11, 84, 40, kGreen);
+  fill(66, 20, 71, 25, kDot);
+  fill(100, 50, 119, 89, {255, 0, 0});  // saturated: the clamps
+  std::mt19937 rng(7);
+  std::uniform_int_distribution<int> noise(-40, 40);
+  for (int y = 0; y < kHeight; ++y) {
+    for (int x = 0; x < kWidth; ++x) {
+      uint8_t* p = frame.row(y) + 3 * x;
+      for (int k = 0; k < 3; ++k)
+        p[k] = static_cast<uint8_t>(std::clamp(p[k] + noise(rng), 0, 255));
+    }
+  }
+  for (PixelFormat format : {PixelFormat::kYuyv, PixelFormat::kNv12, PixelFormat::kYuv420}) {
+    SCOPED_TRACE(to_string(format));
+    const Image yuv = test::convert_rgb(frame, format);
+    Image levels(kWidth, kHeight, PixelFormat::kRgb24);
+    for (int y = 0; y < kHeight; ++y)
+      for (int x = 0; x < kWidth; ++x)
+        test::put_rgb(&levels, x, y, reference_levels(yuv.view(), x, y));
+    const PixelWindow windows[] = {{3, 7, 37, 66}, {55, 5, 91, 45}, {95, 45, 119, 89}};
+    for (bool windowed : {false, true}) {
+      SCOPED_TRACE(windowed ? "windows" : "whole");
+      auto sweep = [&](const Image& image) {
+        const bool ok = windowed ? labeler.label(image.view(), classifier, windows)
+                                 : labeler.label(image.view(), classifier);
+        EXPECT_TRUE(ok);
+        return std::vector<Component>(labeler.components().begin(), labeler.components().end());
+      };
+      const std::vector<Component> want = sweep(levels);
+      const std::vector<Component> got = sweep(yuv);
+      ASSERT_GE(want.size(), 3u);
+      ASSERT_EQ(got.size(), want.size());
+      for (size_t k = 0; k < want.size(); ++k) {
+        EXPECT_EQ(got[k].cls, want[k].cls) << k;
+        EXPECT_EQ(got[k].area_px, want[k].area_px) << k;
+        EXPECT_DOUBLE_EQ(got[k].cx, want[k].cx) << k;
+        EXPECT_DOUBLE_EQ(got[k].cy, want[k].cy) << k;
+      }
+    }
+  }
 }
 
 TEST_F(ComponentsTest, FrameOfAnotherSizeIsRefused) {
