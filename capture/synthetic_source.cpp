@@ -9,6 +9,12 @@
 
 namespace ceilpose::capture {
 
+std::optional<PixelFormat> synthetic_pixel_format(const std::vector<PixelFormat>& wanted) {
+  if (wanted == SourceOptions{}.pixel_formats) return PixelFormat::kRgb24;
+  if (wanted.size() != 1 || wanted.front() == PixelFormat::kMjpeg) return std::nullopt;
+  return wanted.front();
+}
+
 SyntheticSource::SyntheticSource(SourceOptions options, std::shared_ptr<FrameGenerator> generator)
     : options_(std::move(options)), generator_(std::move(generator)) {}
 
@@ -17,8 +23,8 @@ SyntheticSource::~SyntheticSource() = default;
 std::string SyntheticSource::describe() const {
   const CameraIntrinsics& k = generator_->intrinsics();
   char text[160];
-  std::snprintf(text, sizeof text, "synthetic %dx%d %.1f fps, %s", k.width, k.height, options_.fps,
-                generator_->describe().c_str());
+  std::snprintf(text, sizeof text, "synthetic %dx%d %s %.1f fps, %s", k.width, k.height,
+                to_string(generator_->format()), options_.fps, generator_->describe().c_str());
   return text;
 }
 

@@ -12,12 +12,20 @@
 // Threads: see FrameSource; one thread (the capture thread) only.
 #include <memory>
 #include <optional>
+#include <vector>
 
 #include "capture/frame_pool.h"
 #include "capture/frame_source.h"
 #include "core/frame_generator.h"
 
 namespace ceilpose::capture {
+
+// The format the synthetic camera hands its frames over in, for the
+// configured capture.pixel_format list: one format a camera's ISP gives
+// (YUYV, NV12, YUV420, RGB24, BGR24, GRAY8) as is, so that the daemon runs
+// the frame path of a USB or Pi camera; the default list ("auto") RGB24;
+// MJPEG nothing (there is no encoder on the camera's side here).
+std::optional<PixelFormat> synthetic_pixel_format(const std::vector<PixelFormat>& wanted);
 
 class SyntheticSource final : public FrameSource {
  public:

@@ -17,6 +17,8 @@
 #include <utility>
 #include <vector>
 
+#include "capture/source_spec.h"
+#include "capture/synthetic_source.h"
 #include "config/config_schema.h"
 #include "core/text_file.h"
 #include "core/yaml_duplicate_keys.h"
@@ -275,6 +277,11 @@ void check_cross_keys(Reader& r, const ServiceConfig& c) {
       s.reconnect_max_ms >= s.reconnect_initial_ms, "capture.reconnect_max_ms",
       "expected at least capture.reconnect_initial_ms = " + std::to_string(s.reconnect_initial_ms) +
           ", found " + std::to_string(s.reconnect_max_ms));
+  r.require(!capture::is_synthetic_spec(c.capture.source) ||
+                capture::synthetic_pixel_format(s.pixel_formats).has_value(),
+            "capture.pixel_format",
+            "expected auto (RGB24) or a format the synthetic camera hands over (yuyv, nv12, "
+            "yuv420, rgb24, bgr24, gray8), found mjpeg");
   r.require(c.fleet.remove_after_ms >= c.fleet.stale_after_ms, "fleet.remove_after_ms",
             "expected at least fleet.stale_after_ms = " + std::to_string(c.fleet.stale_after_ms) +
                 " (a robot turns stale before it is removed), found " +

@@ -20,6 +20,7 @@
 #include "capture/capture_thread.h"
 #include "capture/frame_source.h"
 #include "capture/source_spec.h"
+#include "capture/synthetic_source.h"
 #include "core/clock.h"
 #include "core/exit_codes.h"
 #include "daemon/cyclone_log.h"
@@ -80,6 +81,8 @@ std::shared_ptr<FrameGenerator> frame_generator(const ServiceConfig& c) {
   o.scene = sim::SceneOptions{c.pipeline.layout, c.pipeline.intrinsics, c.capture.synthetic_seed,
                               nullptr};
   o.mount = c.pipeline.mount;
+  // check_config refused a format the synthetic camera cannot hand over.
+  o.format = capture::synthetic_pixel_format(c.capture.device.pixel_formats).value();
   return std::make_shared<sim::TrajectoryCamera>(o);
 }
 

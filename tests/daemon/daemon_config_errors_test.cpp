@@ -82,6 +82,11 @@ INSTANTIATE_TEST_SUITE_P(
                   "aaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaa"
                   "aaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaa\n",
                   "ipc.shm_name: expected a shared-memory name"},
+        // The synthetic camera hands frames over as a camera would; it has
+        // no JPEG encoder.
+        BadConfig{"SyntheticCameraInMjpeg", "capture:\n  pixel_format: mjpeg\n",
+                  "capture.pixel_format: expected auto (RGB24) or a format the synthetic "
+                  "camera hands over"},
         BadConfig{"ConfigIsADirectory", "", "it is a directory"},
         BadConfig{"ConfigIsNotARegularFile", "", "not a regular file"}),
     [](const auto& info) { return std::string(info.param.name); });

@@ -631,6 +631,29 @@ TEST_F(DaemonLifecycle, LogsWithJournalPrioritiesAndNoTimestampsWhenNotATerminal
   EXPECT_GT(count, 0);
 }
 
+// capture.pixel_format: yuyv makes the synthetic camera hand its frames
+// over as a USB camera does, and the daemon localizes them natively.
+TEST_F(DaemonLifecycle, ASyntheticCameraInYuyvIsLocalizedAsAUsbCamerasFramesAre) {
+  const std::string config =
+      write_temp_file("ceilpose.yaml", config_text() + "capture:\n  pixel_format: yuyv\n");
+  auto r = run_daemon({"--config", config, "--shm", shm_, "--duration", "2", "--print-poses"});
+  ASSERT_EQ(r.exit.code, ceilpose::kExitOk) << r.err;
+  EXPECT_NE(r.err.find("synthetic 640x480 YUYV"), std::string::npos) << r.err;
+  std::istringstream lines(r.out);
+  std::vector<double> errors_mm;
+  for (std::string line; std::getline(lines, line);) {
+    const size_t at = line.find(" err ");
+    if (at != std::string::npos) errors_mm.push_back(std::stod(line.substr(at + 5)));
+  }
+  ASSERT_GE(errors_mm.size(), 5u) << r.out;
+  std::sort(errors_mm.begin(), errors_mm.end());
+  // Measured: median 0.2 mm, max 0.6 mm over 29 poses (RGB: the same). The
+  // synthetic renderer's aliased edges can put a frame ~7 mm off after a
+  // marker row enters the view (docs/decisions.md), hence the looser max.
+  EXPECT_LE(errors_mm[errors_mm.size() / 2], 0.5) << r.out;
+  EXPECT_LE(errors_mm.back(), 10.0) << r.out;
+}
+
 TEST_F(DaemonLifecycle, PrintPosesShowsGroundTruthAndErrorForTheSyntheticSource) {
   auto r = run_daemon({"--config", config_, "--shm", shm_, "--duration", "1.5", "--print-poses"});
   ASSERT_EQ(r.exit.code, ceilpose::kExitOk) << r.err;
