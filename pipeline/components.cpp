@@ -34,7 +34,10 @@ constexpr size_t kRowPadding = 8;
 // arithmetic is also compiled for AVX2 and picked at load time where the
 // CPU has it (GCC function multi-versioning; the same plain loop, no
 // intrinsics). arm64's baseline (NEON) multiplies in vectors already.
-#if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__)
+// Not under the sanitizers: the clones' resolver runs before the sanitizer
+// runtime is set up (a TSan build crashed at start).
+#if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__) && \
+    !defined(__SANITIZE_THREAD__) && !defined(__SANITIZE_ADDRESS__)
 #define CEILPOSE_VECTOR_CLONES [[gnu::target_clones("avx2", "default")]]
 #else
 #define CEILPOSE_VECTOR_CLONES
