@@ -66,7 +66,7 @@ TEST(SyntheticSource, AnyGeneratorFeedsItAndItsTicksAndTimesArriveWithTheFrames)
   SyntheticSource source(at_rate(200.0), generator);
   ASSERT_TRUE(source.open());
   ASSERT_TRUE(source.start());
-  EXPECT_NE(source.describe().find("8x6 200.0 fps, stamps"), std::string::npos)
+  EXPECT_NE(source.describe().find("8x6 RGB24 200.0 fps, stamps"), std::string::npos)
       << source.describe();
   Frame first;
   for (int i = 0; i < 3; ++i) {
