@@ -184,6 +184,7 @@ void describe(V& v, ServiceConfig& c) {
     v.field("lsq_marker_reject_px", q.lsq_marker_reject_px, 0.01, 1000.0);
     v.field("lsq_max_rms_px", q.lsq_max_rms_px, 0.01, 1000.0);
     v.field("lsq_min_points", q.lsq_min_points, 3, 10000);
+    v.field("lsq_edge_points", q.lsq_edge_points);
     v.field("lsq_estimate_tilt", q.lsq_estimate_tilt);
     v.field("lsq_tilt_select_chi2", q.lsq_tilt_select_chi2, 0.0, 1e6);
     v.field("lsq_tilt_select_shift_sigmas", q.lsq_tilt_select_shift_sigmas, 0.0, 1e6);

@@ -49,6 +49,10 @@ int collect_survey_frames(const FrameSources& sources, const char* command,
       setup.config.mount.yaw_rad = 0.0;
     }
     if (camera != nullptr) setup.config.intrinsics = *camera;
+    // The frames' poses only seed the adjustment, under a camera it is
+    // about to find: the edge points, which measure each marker's size,
+    // would refuse frames of a camera whose scale is still off.
+    setup.config.positioning.lsq_edge_points = false;
     if (first) {
       *config = setup.config;
     } else if (!(setup.config.intrinsics == config->intrinsics)) {

@@ -176,60 +176,6 @@ CodeReading read_code(const ImageView& frame, const MarkerFrame& marker, bool re
   return out;
 }
 
-double edge_spread_px(const ImageView& frame, const MarkerFrame& marker, bool red,
-                      const CeilingLayout& layout) {
-  const double e_m = red ? layout.red_centre_e_m() : layout.green_centre_e_m();
-  const double px_per_m = std::hypot(marker.north_u, marker.north_v);
-  if (px_per_m <= 0.0) return -1.0;
-  constexpr int kMaxSamples = 64;
-  // From 1 in inside the end to 1 in outside it, a sample per pixel.
-  const int samples = std::clamp(static_cast<int>(2.0 * kInch_m * px_per_m) + 1, 5, kMaxSamples);
-  const double step_m = 2.0 * kInch_m / (samples - 1);
-  double spread_sum = 0.0;
-  int ends = 0;
-  for (double side : {1.0, -1.0}) {
-    std::array<double, kMaxSamples> level{};
-    bool inside = true;
-    for (int k = 0; k < samples && inside; ++k) {
-      const double n_m = side * (0.5 * layout.rect_height_m - kInch_m + k * step_m);
-      double u = 0.0, v = 0.0;
-      marker.project(e_m, n_m, &u, &v);
-      const int x0 = static_cast<int>(std::floor(u)), y0 = static_cast<int>(std::floor(v));
-      if (x0 < 0 || y0 < 0 || x0 + 1 >= frame.width || y0 + 1 >= frame.height) {
-        inside = false;
-        break;
-      }
-      // The darkest channel: red and green print far below the tile in it.
-      const double fu = u - x0, fv = v - y0;
-      double corner[4];
-      for (int c = 0; c < 4; ++c) {
-        uint8_t r = 0, g = 0, b = 0;
-        read_rgb(frame, x0 + (c & 1), y0 + (c >> 1), &r, &g, &b);
-        corner[c] = std::min({r, g, b});
-      }
-      level[k] = (1 - fv) * ((1 - fu) * corner[0] + fu * corner[1]) +
-                 fv * ((1 - fu) * corner[2] + fu * corner[3]);
-    }
-    if (!inside) continue;
-    const double low = 0.5 * (level[0] + level[1]);
-    const double high = 0.5 * (level[samples - 1] + level[samples - 2]);
-    if (high - low < 30.0) continue;
-    auto crossing = [&](double fraction) {
-      const double target = low + fraction * (high - low);
-      for (int k = 1; k < samples; ++k) {
-        if (level[k] >= target && level[k - 1] < target)
-          return (k - 1) + (target - level[k - 1]) / (level[k] - level[k - 1]);
-      }
-      return -1.0;
-    };
-    const double a = crossing(0.25), b = crossing(0.75);
-    if (a < 0.0 || b < 0.0) continue;
-    spread_sum += (b - a) * step_m * px_per_m;
-    ++ends;
-  }
-  return ends == 0 ? -1.0 : spread_sum / ends;
-}
-
 bool dark_area_consistent(const RectangleCandidate& rect, int code, bool red,
                           const CeilingLayout& layout, double px_per_m) {
   const double dot_area_px =

@@ -36,7 +36,7 @@ struct CodeReading {
 };
 
 // The dot threshold for a marker whose red rectangle's ends spread
-// `blur_px` (edge_spread_px; negative: unmeasured, taken as sharp) with red
+// `blur_px` (rectangle_ends.h's edge_spread_px; negative: unmeasured, taken as sharp) with red
 // dots `red_dot_px` tall: params.dot_threshold_ratio raised with the blur
 // (see DetectorParams::dot_threshold_blur_shift).
 float dot_threshold_ratio(const DetectorParams& params, double blur_px, double red_dot_px);
@@ -47,15 +47,6 @@ float dot_threshold_ratio(const DetectorParams& params, double blur_px, double r
 CodeReading read_code(const ImageView& frame, const MarkerFrame& marker, bool red,
                       const CeilingLayout& layout, const DetectorParams& params,
                       float threshold_ratio);
-
-// Blur along North at the rectangle's two short ends, in pixels: the
-// distance over which the darkest channel climbs from 25 % to 75 % of the
-// way from the rectangle's level to the tile's (0.5 px for a sharp edge;
-// 1.35 σ for Gaussian blur; half the length of motion blur along North).
-// Negative when it cannot be measured (an end outside the frame, too little
-// contrast). Sparse reads, no allocation.
-double edge_spread_px(const ImageView& frame, const MarkerFrame& marker, bool red,
-                      const CeilingLayout& layout);
 
 // Whether the dark pixels found inside a rectangle fit the dots its code
 // says it has: more dark area than the dots plus slack means dirt, an

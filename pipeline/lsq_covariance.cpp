@@ -111,7 +111,7 @@ bool LsqCovariance::robot_covariance(const ViewGeometry& view, const Positioning
                                      const Pose2D& robot, std::array<double, 9>* out) {
   const LsqNormal placement =
       placement_information(view, params, points, fixes, consistent, use, st);
-  const double dof = std::max(1, 2 * n - model.free_count());
+  const double dof = std::max(1, n - model.free_count());
   const double sigma2 = wr2 / dof;
   // g = the first three columns of (J^T W J)^-1.
   std::array<LsqVector, 3> g{};

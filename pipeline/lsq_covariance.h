@@ -17,7 +17,7 @@ class LsqCovariance {
  public:
   // The robot's (x_m, y_m, yaw_rad) covariance, row-major, at the solution
   // `st` with normal equations `a` (priors included) and the Huber-weighted
-  // squared residuals wr2 of n points. `consistent`: the markers grid
+  // squared residuals wr2 of n residuals. `consistent`: the markers grid
   // consistency kept (the solve may have rejected some of them since), `use`:
   // those the solve kept. False when the normal equations are singular.
   bool robot_covariance(const ViewGeometry& view, const PositioningParams& params,

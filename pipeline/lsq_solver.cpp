@@ -29,12 +29,12 @@ bool LsqSolver::solve(const ViewGeometry& view, const PositioningParams& params,
   // A global shutter has no motion within the frame to hold or estimate.
   seed.model.motion = view.intrinsics().readout_ms > 0.0 ? motion : CameraMotion{};
   std::copy(use.begin(), use.end(), seed.use.begin());
-  seed.markers = gather_points(view, markers, fixes, use, seed.model, &seed.state);
+  seed.markers = gather_points(view, params, markers, fixes, use, seed.model, &seed.state);
   if (seed.markers == 0 || point_count_ < params.lsq_min_points) return false;
   const bool motion_free = motion_observable(view, params, use, seed.markers);
-  seed.model.active = {true,        true,        true,
-                       false,       false,       params.lsq_estimate_height,
-                       motion_free, motion_free, motion_free};
+  seed.model.active = {
+      true,        true,        true,        false,           false, params.lsq_estimate_height,
+      motion_free, motion_free, motion_free, edge_points_ > 0};
 
   // 2. Which tilt model the points support, each fit with its own marker
   // rejection.
@@ -50,7 +50,7 @@ bool LsqSolver::solve(const ViewGeometry& view, const PositioningParams& params,
   int n = 0;
   accumulate(view, params, points(), kept, fit.state, true, &a, &b, &wr2, &n);
   prior_cost(view, params, fit.model, fit.state, &a, &b);
-  if (n < params.lsq_min_points) return false;
+  if (n < 2 * params.lsq_min_points) return false;  // two residuals a point
   const double rms = rms_px(view, kept, fit.state, n);
   if (!(rms <= params.lsq_max_rms_px)) return false;
 
@@ -63,7 +63,8 @@ bool LsqSolver::solve(const ViewGeometry& view, const PositioningParams& params,
   out->rms_px = rms;
   out->markers = fit.markers;
   out->rejected = seed.markers - fit.markers;
-  out->points = n;
+  out->points = 0;
+  for (const LsqPoint& pt : points()) out->points += kept[pt.fix] ? 1 : 0;
   out->iterations = iterations;
   camera_tilt_of(fit.state.r_wc, &out->tilt_x_rad, &out->tilt_y_rad);
   out->lens_height_m = fit.state.t_w[2];
@@ -73,6 +74,7 @@ bool LsqSolver::solve(const ViewGeometry& view, const PositioningParams& params,
   out->cam_vx_mps = fit.state.vx;
   out->cam_vy_mps = fit.state.vy;
   out->yaw_rate_radps = fit.state.w;
+  out->edge_offset_px = fit.state.edge_offset_px;
   std::copy(kept.begin(), kept.end(), use.begin());
   return true;
 }
@@ -81,26 +83,45 @@ bool LsqSolver::solve(const ViewGeometry& view, const PositioningParams& params,
 // still gives its centre and its two rectangle centres), and the seed: the
 // Change of Axes answers averaged, nominal tilt and height, the motion held.
 // Returns the markers used.
-int LsqSolver::gather_points(const ViewGeometry& view, std::span<const MarkerObservation> markers,
+int LsqSolver::gather_points(const ViewGeometry& view, const PositioningParams& params,
+                             std::span<const MarkerObservation> markers,
                              std::span<const MarkerFix> fixes, std::span<const bool> use,
                              const LsqModel& model, LsqState* seed) {
   const CeilingLayout& layout = view.layout();
   const CameraIntrinsics& k = view.intrinsics();
   point_count_ = 0;
+  edge_points_ = 0;
   int marker_count = 0;
   double sin_sum = 0.0, cos_sum = 0.0, x_sum = 0.0, y_sum = 0.0;
   for (int f = 0; f < static_cast<int>(fixes.size()); ++f) {
     if (!use[f]) continue;
     const MarkerFix& fix = fixes[f];
     const MarkerObservation& m = markers[fix.index];
-    auto add = [&](double e_m, double n_m, double u_px, double v_px) {
+    auto add = [&](double e_m, double n_m, double u_px, double v_px, double normal_u = 0.0,
+                   double normal_v = 0.0) {
       if (point_count_ >= static_cast<int>(points_.size())) return;
       if (!std::isfinite(u_px) || !std::isfinite(v_px) || !std::isfinite(e_m) ||
-          !std::isfinite(n_m)) {
+          !std::isfinite(n_m) || !std::isfinite(normal_u) || !std::isfinite(normal_v)) {
         return;
       }
       LsqPoint& p = points_[point_count_++];
       undistort_pixel(k, u_px, v_px, &p.x_n, &p.y_n);
+      p.normal_x = p.normal_y = 0.0;
+      if (normal_u != 0.0 || normal_v != 0.0) {
+        // The normal as the residual sees it: undistorted, in f-scaled
+        // normalized coordinates, a pixel's step along it.
+        double x1 = 0.0, y1 = 0.0;
+        undistort_pixel(k, u_px + normal_u, v_px + normal_v, &x1, &y1);
+        const double nx = k.fx * (x1 - p.x_n), ny = k.fy * (y1 - p.y_n);
+        const double len = std::hypot(nx, ny);
+        if (!(len > 0.0)) {
+          --point_count_;
+          return;
+        }
+        p.normal_x = nx / len;
+        p.normal_y = ny / len;
+        ++edge_points_;
+      }
       p.tau_s = row_time_s(k, v_px);
       double x_m = 0.0, y_m = 0.0;
       fix.placement->world_point(e_m, n_m, &x_m, &y_m);
@@ -109,7 +130,9 @@ int LsqSolver::gather_points(const ViewGeometry& view, std::span<const MarkerObs
     };
     if (m.point_count > 0) {
       for (int i = 0; i < std::min(m.point_count, kMaxPointsPerMarker); ++i) {
-        add(m.points[i].e_m, m.points[i].n_m, m.points[i].u_px, m.points[i].v_px);
+        const MarkerPointObservation& o = m.points[i];
+        if (o.is_edge() && !params.lsq_edge_points) continue;
+        add(o.e_m, o.n_m, o.u_px, o.v_px, o.normal_u, o.normal_v);
       }
     } else {
       add(0.0, 0.0, m.centre_u_px, m.centre_v_px);
@@ -178,7 +201,7 @@ LsqSolver::Fit LsqSolver::choose_tilt_model(const ViewGeometry& view,
   int n = 0;
   const std::span<const bool> free_use(free.use.data(), fixes.size());
   accumulate(view, params, points(), free_use, free.state, false, &a, &b, &wr2, &n);
-  const double sigma2 = free.cost / std::max(1, 2 * n - free.model.free_count());
+  const double sigma2 = free.cost / std::max(1, n - free.model.free_count());
   out->tilt_chi2 = sigma2 > 0.0 ? (held.cost - free.cost) / sigma2 : 0.0;
   out->tilt_shift_m =
       std::hypot(free.state.t_w[0] - held.state.t_w[0], free.state.t_w[1] - held.state.t_w[1]);
@@ -196,10 +219,10 @@ LsqSolver::Fit LsqSolver::choose_tilt_model(const ViewGeometry& view,
 
 // The 1-sigma of the optical centre's horizontal position, metres, from the
 // normal equations `a` of a fit whose Huber-weighted squared residuals are
-// wr2 over n points; infinite when `a` is singular.
+// wr2 over n residuals; infinite when `a` is singular.
 double LsqSolver::position_sigma_m(const LsqModel& model, const LsqNormal& a, double wr2,
                                    int n) const {
-  const double sigma2 = wr2 / std::max(1, 2 * n - model.free_count());
+  const double sigma2 = wr2 / std::max(1, n - model.free_count());
   double var_m2 = 0.0;
   for (int axis : {kLsqTx, kLsqTy}) {
     LsqVector e{}, g{};
@@ -270,6 +293,10 @@ void LsqSolver::optimise(const ViewGeometry& view, const PositioningParams& para
       model.active[kLsqVx] = model.active[kLsqVy] = model.active[kLsqYawRate] = false;
       st = held_motion(model, st);
     }
+    if (model.active[kLsqEdgeOffset] && !edge_points_in_use(use)) {
+      model.active[kLsqEdgeOffset] = false;
+      st.edge_offset_px = 0.0;
+    }
   }
 }
 
@@ -281,14 +308,15 @@ int LsqSolver::worst_marker(const ViewGeometry& view, const PositioningParams& p
   for (int f = 0; f < static_cast<int>(fixes.size()); ++f) {
     if (!fit.use[f]) continue;
     double sum = 0.0;
-    int cnt = 0;
+    int residuals = 0;
     for (const LsqPoint& pt : points()) {
       if (pt.fix != f) continue;
       sum += residual2_px(view, fit.state, pt);
-      ++cnt;
+      residuals += pt.residuals();
     }
-    if (cnt > 0 && sum / cnt > worst_rms2) {
-      worst_rms2 = sum / cnt;
+    // Per point: two residuals (an edge point has one).
+    if (residuals > 0 && 2.0 * sum / residuals > worst_rms2) {
+      worst_rms2 = 2.0 * sum / residuals;
       worst = f;
     }
   }
@@ -310,7 +338,16 @@ bool LsqSolver::motion_observable(const ViewGeometry& view, const PositioningPar
   return hi - lo >= params.lsq_motion_min_row_span * readout_s;
 }
 
-// 3. RMS reprojection residual of the points in use, pixels.
+// Whether any marker in use has an edge point (else the edge offset has no
+// column in the normal equations).
+bool LsqSolver::edge_points_in_use(std::span<const bool> use) const {
+  for (const LsqPoint& pt : points())
+    if (use[pt.fix] && pt.is_edge()) return true;
+  return false;
+}
+
+// 3. RMS reprojection residual of the points in use, pixels, per point (two
+// residuals; n residuals in all).
 double LsqSolver::rms_px(const ViewGeometry& view, std::span<const bool> use, const LsqState& st,
                          int n) const {
   double sum_r2 = 0.0;
@@ -318,7 +355,7 @@ double LsqSolver::rms_px(const ViewGeometry& view, std::span<const bool> use, co
     if (!use[pt.fix]) continue;
     sum_r2 += residual2_px(view, st, pt);
   }
-  return std::sqrt(sum_r2 / n);
+  return std::sqrt(2.0 * sum_r2 / n);
 }
 
 }  // namespace ceilpose

@@ -56,6 +56,8 @@ struct LsqResult {
   double yaw_rate_radps = 0.0;
   bool motion_estimated = false;
   bool motion_held = false;  // not estimated: held at the caller's motion
+  // The edge points' outward offset, pixels (lsq_terms.h); 0 without them.
+  double edge_offset_px = 0.0;
 };
 
 // Holds the per-frame work arrays (sized for the largest frame), so solve()
@@ -85,9 +87,9 @@ class LsqSolver {
   };
 
   // The steps of solve(), in order (see lsq_solver.cpp).
-  int gather_points(const ViewGeometry& view, std::span<const MarkerObservation> markers,
-                    std::span<const MarkerFix> fixes, std::span<const bool> use,
-                    const LsqModel& model, LsqState* seed);
+  int gather_points(const ViewGeometry& view, const PositioningParams& params,
+                    std::span<const MarkerObservation> markers, std::span<const MarkerFix> fixes,
+                    std::span<const bool> use, const LsqModel& model, LsqState* seed);
   Fit choose_tilt_model(const ViewGeometry& view, const PositioningParams& params,
                         std::span<const MarkerFix> fixes, const Fit& seed, int* iterations,
                         LsqResult* out);
@@ -97,6 +99,7 @@ class LsqSolver {
                    std::span<const MarkerFix> fixes, const Fit& fit) const;
   bool motion_observable(const ViewGeometry& view, const PositioningParams& params,
                          std::span<const bool> use, int marker_count) const;
+  bool edge_points_in_use(std::span<const bool> use) const;
   double position_sigma_m(const LsqModel& model, const LsqNormal& a, double wr2, int n) const;
   double rms_px(const ViewGeometry& view, std::span<const bool> use, const LsqState& st,
                 int n) const;
@@ -104,6 +107,7 @@ class LsqSolver {
 
   std::array<LsqPoint, kMaxMarkersPerFrame * kMaxPointsPerMarker> points_{};
   int point_count_ = 0;
+  int edge_points_ = 0;  // of point_count_
   LsqCovariance covariance_;
 };
 

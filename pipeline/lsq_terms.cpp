@@ -28,6 +28,14 @@ void camera_at(const LsqState& st, double tau_s, Vec3* t_w, Mat3* r_wc) {
   *r_wc = turned(st.r_wc, st.w * tau_s);
 }
 
+// An edge point keeps only its residual's component across the edge, less
+// the edge offset (observed = projected + offset·normal).
+void across_edge(const LsqPoint& pt, double offset_px, double* x, double* y) {
+  if (!pt.is_edge()) return;
+  *x = pt.normal_x * *x + pt.normal_y * *y - offset_px;
+  *y = 0.0;
+}
+
 }  // namespace
 
 int LsqModel::free_count() const {
@@ -40,7 +48,8 @@ PointCamera centre_camera(const LsqState& st) {
   const Mat3 lev = level_rotation(camera_yaw_of(st.r_wc));
   return {{},
           mat_transpose(st.r_wc),
-          {{{0.0, 0.0, 1.0}, {lev[0], lev[3], lev[6]}, {lev[1], lev[4], lev[7]}}}};
+          {{{0.0, 0.0, 1.0}, {lev[0], lev[3], lev[6]}, {lev[1], lev[4], lev[7]}}},
+          st.edge_offset_px};
 }
 
 PointCamera point_camera(const LsqState& st, const LsqPoint& pt, const PointCamera& centre,
@@ -71,6 +80,7 @@ bool point_residual(const ViewGeometry& view, const LsqPoint& pt, const PointCam
   if (p[2] < 1e-3) return false;
   *rx = normalized_residual_px(view.intrinsics().fx, pt.x_n, p[0], p[2]);
   *ry = normalized_residual_px(view.intrinsics().fy, pt.y_n, p[1], p[2]);
+  across_edge(pt, cam.edge_offset_px, rx, ry);
   return true;
 }
 
@@ -109,6 +119,10 @@ void point_jacobian(const ViewGeometry& view, const LsqPoint& pt, const PointCam
   jy[kLsqVx] = pt.tau_s * jy[kLsqTx];
   jy[kLsqVy] = pt.tau_s * jy[kLsqTy];
   jy[kLsqYawRate] = pt.tau_s * jy[kLsqYaw];
+  jx[kLsqEdgeOffset] = jy[kLsqEdgeOffset] = 0.0;
+  if (!pt.is_edge()) return;
+  for (int c = 0; c < kN; ++c) across_edge(pt, 0.0, &jx[c], &jy[c]);
+  jx[kLsqEdgeOffset] = -1.0;
 }
 
 double residual2_px(const ViewGeometry& view, const LsqState& st, const LsqPoint& pt) {
@@ -117,14 +131,16 @@ double residual2_px(const ViewGeometry& view, const LsqState& st, const LsqPoint
   camera_at(st, pt.tau_s, &t_w, &r_wc);
   const Vec3 p = mat_vec(mat_transpose(r_wc),
                          {pt.world[0] - t_w[0], pt.world[1] - t_w[1], pt.world[2] - t_w[2]});
-  const double rx = normalized_residual_px(view.intrinsics().fx, pt.x_n, p[0], p[2]);
-  const double ry = normalized_residual_px(view.intrinsics().fy, pt.y_n, p[1], p[2]);
+  double rx = normalized_residual_px(view.intrinsics().fx, pt.x_n, p[0], p[2]);
+  double ry = normalized_residual_px(view.intrinsics().fy, pt.y_n, p[1], p[2]);
+  across_edge(pt, st.edge_offset_px, &rx, &ry);
   return rx * rx + ry * ry;
 }
 
 double accumulate(const ViewGeometry& view, const PositioningParams& params,
                   std::span<const LsqPoint> points, std::span<const bool> use, const LsqState& st,
-                  bool with_jacobian, LsqNormal* a, LsqVector* b, double* sum_w_r2, int* count) {
+                  bool with_jacobian, LsqNormal* a, LsqVector* b, double* sum_w_r2,
+                  int* residuals) {
   const double k = params.lsq_huber_px;
   const PointCamera centre = centre_camera(st);
   if (with_jacobian) {
@@ -142,7 +158,7 @@ double accumulate(const ViewGeometry& view, const PositioningParams& params,
     const double w = r <= k ? 1.0 : k / r;
     cost += r <= k ? r * r : 2.0 * k * r - k * k;
     wr2 += w * r * r;
-    ++n;
+    n += pt.residuals();
     if (!with_jacobian) continue;
     double jx[kN], jy[kN];
     point_jacobian(view, pt, cam, jx, jy);
@@ -156,7 +172,7 @@ double accumulate(const ViewGeometry& view, const PositioningParams& params,
       for (int c = 0; c < r1; ++c) (*a)[r1 * kN + c] = (*a)[c * kN + r1];
   }
   *sum_w_r2 = wr2;
-  *count = n;
+  *residuals = n;
   return cost;
 }
 
@@ -222,6 +238,7 @@ LsqState stepped(const LsqState& st, const LsqVector& step) {
   out.vx += step[kLsqVx];
   out.vy += step[kLsqVy];
   out.w += step[kLsqYawRate];
+  out.edge_offset_px += step[kLsqEdgeOffset];
   return out;
 }
 

@@ -9,8 +9,11 @@
 // Unknowns: the optical centre t (x, y, optionally z), a rotation increment
 // applied on the left, R ← Exp(ω)·R with ω = δψ·ẑ + δa·Xl + δb·Yl (Xl, Yl
 // the level camera's axes: δψ is exactly a yaw change, δa and δb tilt
-// changes), and, with a rolling shutter, the optical centre's velocity and
-// the yaw rate during the readout.
+// changes), with a rolling shutter the optical centre's velocity and the yaw
+// rate during the readout, and with edge points the edge offset: how far
+// outwards, pixels, every edge's half-way level lies from the edge itself
+// (gamma, glare and a lens's blur move the half-way level of a dark-on-light
+// step alike on every edge).
 #include <array>
 #include <span>
 
@@ -20,7 +23,7 @@
 
 namespace ceilpose {
 
-inline constexpr int kLsqParams = 9;
+inline constexpr int kLsqParams = 10;
 enum LsqParam : int {
   kLsqTx = 0,
   kLsqTy = 1,
@@ -30,17 +33,24 @@ enum LsqParam : int {
   kLsqTz = 5,
   kLsqVx = 6,
   kLsqVy = 7,
-  kLsqYawRate = 8
+  kLsqYawRate = 8,
+  kLsqEdgeOffset = 9
 };
 using LsqNormal = std::array<double, kLsqParams * kLsqParams>;
 using LsqVector = std::array<double, kLsqParams>;
 
-// One image point and the ceiling point it is of.
+// One image point and the ceiling point it is of. An edge point (a
+// MarkerPointObservation with a normal) has one residual: the pixel
+// residual's component along its unit outward normal (normal_x, normal_y),
+// less the edge offset; the other component is zero.
 struct LsqPoint {
   double x_n, y_n;  // undistorted normalized observation (camera frame)
   Vec3 world;       // marker point on the ceiling
   int fix;          // index into the frame's marker fixes
   double tau_s;     // when its row was exposed, after the centre row (rolling shutter)
+  double normal_x = 0.0, normal_y = 0.0;
+  bool is_edge() const { return normal_x != 0.0 || normal_y != 0.0; }
+  int residuals() const { return is_edge() ? 1 : 2; }
 };
 
 // The camera at the centre row's instant, and its motion during the readout.
@@ -48,6 +58,7 @@ struct LsqState {
   Vec3 t_w{};                          // optical centre
   Mat3 r_wc{};                         // camera axes in the world
   double vx = 0.0, vy = 0.0, w = 0.0;  // optical centre velocity, yaw rate
+  double edge_offset_px = 0.0;         // edge points' outward offset
 };
 
 // Which unknowns a fit frees, and the motion it holds them at or draws them
@@ -61,11 +72,12 @@ struct LsqModel {
 };
 
 // What a point's residual and Jacobian need of its camera: Rᵀ, the
-// increment axes and d = P − t.
+// increment axes and d = P − t; and the state's edge offset.
 struct PointCamera {
   Vec3 d;
   Mat3 rt;
   std::array<Vec3, 3> axis;
+  double edge_offset_px = 0.0;
 };
 
 // The camera at the centre row: Rᵀ and the world directions of the yaw and
@@ -92,10 +104,11 @@ double residual2_px(const ViewGeometry& view, const LsqState& st, const LsqPoint
 
 // Huber-weighted normal equations (with_jacobian) and the robust cost of
 // the points whose marker is in use; infinite when a point is behind the
-// camera. *sum_w_r2 and *count: the weighted squared residuals and points.
+// camera. *sum_w_r2 and *residuals: the weighted squared residuals and how
+// many residuals there are (two a point, one an edge point).
 double accumulate(const ViewGeometry& view, const PositioningParams& params,
                   std::span<const LsqPoint> points, std::span<const bool> use, const LsqState& st,
-                  bool with_jacobian, LsqNormal* a, LsqVector* b, double* sum_w_r2, int* count);
+                  bool with_jacobian, LsqNormal* a, LsqVector* b, double* sum_w_r2, int* residuals);
 
 // The priors' cost, added to the normal equations when `a` is given: the
 // motion towards the caller's (or rest), the tilt towards the mount's.

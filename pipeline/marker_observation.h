@@ -9,12 +9,19 @@ namespace ceilpose {
 
 // One correspondence: a point of the marker (marker frame, e East, n North,
 // origin at the marker centre, metres) and where it was measured in the
-// image (distorted pixel coordinates, as in the frame).
+// image (distorted pixel coordinates, as in the frame). An edge point
+// (normal ≠ 0) was found on the image of a straight edge of the marker
+// through (e, n), by a search across it: only its distance across the edge
+// is measured (along (normal_u, normal_v), a unit image direction), so a
+// solve uses its residual in that direction alone.
 struct MarkerPointObservation {
   double e_m = 0.0;
   double n_m = 0.0;
   double u_px = 0.0;
   double v_px = 0.0;
+  double normal_u = 0.0;
+  double normal_v = 0.0;
+  bool is_edge() const { return normal_u != 0.0 || normal_v != 0.0; }
 };
 
 inline constexpr int kMaxPointsPerMarker = 24;

@@ -6,6 +6,7 @@
 
 #include "core/clock.h"
 #include "pipeline/dot_reader.h"
+#include "pipeline/rectangle_ends.h"
 
 namespace ceilpose {
 namespace {
@@ -95,7 +96,8 @@ PairOutcome Pipeline::decode(const ImageView& frame, const MarkerPair& pair,
   // threshold lies.
   const double px_per_m = std::hypot(m.north_u, m.north_v);
   const double red_dot_px = layout.red_dot_n_m * px_per_m;
-  const double blur_px = edge_spread_px(frame, m, true, layout);
+  const RectangleEdges red_edges = measure_edges(frame, m, true, layout);
+  const double blur_px = red_edges.spread_px;
   if (blur_px > config_.detector.max_blur_to_dot * red_dot_px) {
     return PairOutcome::kBlurred;
   }
@@ -147,6 +149,18 @@ PairOutcome Pipeline::decode(const ImageView& frame, const MarkerPair& pair,
   o.points[o.point_count++] = {0.0, 0.0, m.centre_u_px, m.centre_v_px};
   o.points[o.point_count++] = {layout.red_centre_e_m(), 0.0, red.cx, red.cy};
   o.points[o.point_count++] = {layout.green_centre_e_m(), 0.0, green.cx, green.cy};
+  // And the rectangles' edges around them: what lets a fit tell a tilt
+  // from a shift marker by marker (rectangle_ends.h). Each is measured
+  // across its edge only.
+  const RectangleEdges green_edges = measure_edges(frame, m, false, layout);
+  auto add_edge = [&](const EdgeCrossing& c) {
+    if (!c.found || o.point_count == kMaxPointsPerMarker) return;
+    o.points[o.point_count++] = {c.e_m, c.n_m, c.u_px, c.v_px, c.normal_u, c.normal_v};
+  };
+  for (const RectangleEdges* edges : {&red_edges, &green_edges}) {
+    for (const EdgeCrossing& c : edges->end) add_edge(c);
+    for (int k = 0; k < edges->side_count; ++k) add_edge(edges->side[static_cast<size_t>(k)]);
+  }
   return PairOutcome::kDecoded;
 }
 

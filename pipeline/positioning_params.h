@@ -34,6 +34,13 @@ struct PositioningParams {
   // three points (centre, rectangle centres) already fix position and yaw
   // with tilt held; tilt needs lsq_tilt_min_markers.
   int lsq_min_points = 3;
+  // Solve from the rectangles' edge points as well as their centroids
+  // (pipeline/rectangle_ends.h). They tell a tilt from a shift marker by
+  // marker (tilted independent renders: p99 6.1 -> 2.1 mm; level: median
+  // 0.31 -> 0.13 mm), but they also measure each marker's size, so a camera
+  // whose focal length or distortion is far off fits them badly: off only
+  // while such a camera is being calibrated (survey, calibrate robot).
+  bool lsq_edge_points = true;
   // Solve roll/pitch tilt of the camera (true) or hold it at the mount's
   // nominal tilt (false). Tilt costs nothing and absorbs a camera that is not
   // quite level; hold it only for single-marker views (done automatically).

@@ -509,6 +509,10 @@ Result<SurveyReport> survey_ceiling(const PipelineConfig& config,
         frames[static_cast<size_t>(s.frame)].markers[static_cast<size_t>(s.marker)];
     for (int p = 0; p < std::min(m.point_count, kMaxPointsPerMarker); ++p) {
       const MarkerPointObservation& pt = m.points[static_cast<size_t>(p)];
+      // Edge points are measured across their edge only; the survey's
+      // marker size and intrinsics were settled on the centroids, which
+      // carry its scale (decisions.md, "Edge points").
+      if (pt.is_edge()) continue;
       auto* cost = new ceres::AutoDiffCostFunction<Reprojection, 2, 3, 3, 2, 9, 1>(
           new Reprojection{pt.e_m, pt.n_m, pt.u_px, pt.v_px, depth_m, config.mount.tilt_x_rad,
                            config.mount.tilt_y_rad});

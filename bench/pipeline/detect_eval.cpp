@@ -18,6 +18,7 @@
 
 #include "pipeline/dot_reader.h"
 #include "pipeline/pipeline.h"
+#include "pipeline/rectangle_ends.h"
 #include "sim/renderer.h"
 #include "sim/scenarios.h"
 #include "sim/visibility.h"

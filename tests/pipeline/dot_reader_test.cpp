@@ -5,7 +5,9 @@
 #include <algorithm>
 #include <cmath>
 #include <numbers>
+#include <vector>
 
+#include "pipeline/rectangle_ends.h"
 #include "tests/pipeline/detect_scene_support.h"
 
 namespace ceilpose {
@@ -106,6 +108,60 @@ TEST_F(DotReaderTest, EdgeSpreadGrowsWithBlurAlongNorth) {
   const double blurred_px = edge_spread_px(test::blur_rows(sharp, 7).view(), f, true, layout);
   EXPECT_GT(blurred_px, 2.5);
   EXPECT_LT(blurred_px, 5.0);
+}
+
+// The edges a fit can tell a tilt by (rectangle_ends.h): on a turned marker
+// with dots next to the ends and sides, every edge point lies the same
+// distance across its edge, sharp or blurred along one image axis (the
+// positioning solves that common offset: lsq_terms.h), and its normal
+// points out of the rectangle.
+TEST_F(DotReaderTest, EdgePointsLieAlikeAcrossTheRectanglesEdgesSharpOrBlurred) {
+  test::CraftedMarker m;
+  m.centre_u_px = 160.4;
+  m.centre_v_px = 119.3;
+  m.west_image_rad = 2.0;
+  m.code_i = 7;
+  m.code_j = 7;
+  const Image sharp = test::render_markers(320, 240, std::span(&m, 1), layout);
+  const MarkerFrame f = frame_of(m, layout);
+  // Measured (px, across the edge, outwards): sharp -0.13 to -0.22, 5 px
+  // box blur -0.17 to -0.29.
+  for (const Image& image : {sharp, test::blur_rows(sharp, 5)}) {
+    std::vector<double> across_px;
+    for (bool red : {true, false}) {
+      const RectangleEdges edges = measure_edges(image.view(), f, red, layout);
+      ASSERT_EQ(edges.side_count, layout.bits - 1);
+      std::vector<EdgeCrossing> all{edges.end[0], edges.end[1]};
+      for (int k = 0; k < edges.side_count; ++k) all.push_back(edges.side[k]);
+      for (const EdgeCrossing& c : all) {
+        ASSERT_TRUE(c.found);
+        double u = 0.0, v = 0.0;
+        f.project(c.e_m, c.n_m, &u, &v);
+        across_px.push_back((c.u_px - u) * c.normal_u + (c.v_px - v) * c.normal_v);
+        // Outwards: away from the rectangle's centre.
+        double cu = 0.0, cv = 0.0;
+        f.project(red ? layout.red_centre_e_m() : layout.green_centre_e_m(), 0.0, &cu, &cv);
+        EXPECT_GT((u - cu) * c.normal_u + (v - cv) * c.normal_v, 0.0);
+      }
+    }
+    ASSERT_EQ(across_px.size(), 8u);
+    double mean_px = 0.0;
+    for (double a : across_px) mean_px += a / across_px.size();
+    EXPECT_LT(std::abs(mean_px), 0.3);
+    for (double a : across_px) EXPECT_NEAR(a, mean_px, 0.1);
+  }
+}
+
+// An edge whose profiles do not all find it (here the North end, beyond
+// the frame's right border) gives no point rather than a lopsided one.
+TEST_F(DotReaderTest, AnEdgeOutsideTheFrameGivesNoPoint) {
+  test::CraftedMarker m;
+  m.centre_u_px = 320.0 - 0.5 * layout.rect_height_m * test::kDefaultPxPerM - 2.0;
+  m.centre_v_px = 120.0;
+  const Image image = test::render_markers(320, 240, std::span(&m, 1), layout);
+  const RectangleEdges edges = measure_edges(image.view(), frame_of(m, layout), true, layout);
+  EXPECT_FALSE(edges.end[0].found);  // North is image right at yaw 0
+  EXPECT_TRUE(edges.end[1].found);
 }
 
 TEST_F(DotReaderTest, DotThresholdRisesWithBlurRelativeToTheDot) {

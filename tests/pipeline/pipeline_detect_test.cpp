@@ -96,13 +96,31 @@ TEST_F(PipelineDetectTest, PointsCarryTheirMarkerFrameCoordinates) {
   pipeline.process(image.view(), PositioningMode::kAuto, &result);
   ASSERT_EQ(result.marker_count, 1);
   const MarkerObservation& o = result.markers[0];
-  ASSERT_GE(o.point_count, 3);
+  // Centre, two centroids; both ends and the two between-slot stretches of
+  // the outer long side of each rectangle.
+  ASSERT_EQ(o.point_count, 3 + 2 * (2 + 2));
+  int edges = 0;
   for (int p = 0; p < o.point_count; ++p) {
     // Where the point should be: at yaw 0, East is image up, North right.
     const MarkerPointObservation& pt = o.points[p];
-    EXPECT_NEAR(pt.u_px, m.centre_u_px + pt.n_m * test::kDefaultPxPerM, 0.3) << p;
-    EXPECT_NEAR(pt.v_px, m.centre_v_px - pt.e_m * test::kDefaultPxPerM, 0.3) << p;
+    const double du = pt.u_px - (m.centre_u_px + pt.n_m * test::kDefaultPxPerM);
+    const double dv = pt.v_px - (m.centre_v_px - pt.e_m * test::kDefaultPxPerM);
+    if (!pt.is_edge()) {
+      EXPECT_NEAR(du, 0.0, 0.3) << p;
+      EXPECT_NEAR(dv, 0.0, 0.3) << p;
+      continue;
+    }
+    ++edges;
+    // An edge point is measured across its edge, and its normal points out
+    // of the rectangle: an end's along ±North (image ±u), a side's along
+    // ±East (image ∓v).
+    EXPECT_NEAR(du * pt.normal_u + dv * pt.normal_v, 0.0, 0.15) << p;
+    const bool end = std::abs(std::abs(pt.n_m) - 0.5 * config.layout.rect_height_m) < 1e-9;
+    EXPECT_NEAR(end ? pt.normal_u : -pt.normal_v,
+                end ? (pt.n_m > 0 ? 1.0 : -1.0) : (pt.e_m > 0 ? 1.0 : -1.0), 1e-3)
+        << p;
   }
+  EXPECT_EQ(edges, 8);
 }
 
 TEST_F(PipelineDetectTest, RgbBgrYuyvAnd420FramesGiveTheSameDetections) {

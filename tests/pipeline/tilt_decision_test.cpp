@@ -7,6 +7,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <numbers>
 #include <random>
 #include <vector>
@@ -15,6 +16,7 @@
 #include "independent_metrics_support.h"
 #include "independent_renderer_support.h"
 #include "pipeline/pipeline.h"
+#include "sim/camera_format.h"
 
 namespace ceilpose {
 namespace {
@@ -28,7 +30,7 @@ struct TiltRun {
 
 // `frames` random poses over the grid's inner part, tilted by 0.1–3° in a
 // random direction (or level), read noise 2, solved by lsq alone.
-TiltRun run(int frames, bool level, uint64_t seed) {
+TiltRun run(int frames, bool level, uint64_t seed, PixelFormat format = PixelFormat::kRgb24) {
   PipelineConfig config;
   Pipeline pipeline(config);
   FrameResult result;
@@ -48,14 +50,11 @@ TiltRun run(int frames, bool level, uint64_t seed) {
     options.noise_sigma = 2.0;
     options.seed = static_cast<uint64_t>(k) + 1;
     const cv::Mat rgb = render_rgb(XCamera{}, mount, pose, options);
-    ImageView view;
-    view.data = rgb.data;
-    view.width = rgb.cols;
-    view.height = rgb.rows;
-    view.stride_bytes = static_cast<int>(rgb.step);
-    view.format = PixelFormat::kRgb24;
-    view.size_bytes = rgb.total() * rgb.elemSize();
-    pipeline.process(view, PositioningMode::kLeastSquares, &result);
+    Image image(rgb.cols, rgb.rows, PixelFormat::kRgb24);
+    for (int y = 0; y < rgb.rows; ++y)
+      std::memcpy(image.data() + y * image.stride_bytes(), rgb.ptr(y), 3 * size_t(rgb.cols));
+    if (format != PixelFormat::kRgb24) image = sim::convert_rgb(image, format);
+    pipeline.process(image.view(), PositioningMode::kLeastSquares, &result);
     const PoseEstimate& e = result.estimate;
     if (!e.valid || e.markers < 6) continue;
     out.errors_mm.push_back(1e3 * std::hypot(e.pose.x_m - pose.x_m, e.pose.y_m - pose.y_m));
@@ -69,28 +68,40 @@ double p99(const std::vector<double>& sorted) {
   return sorted[std::min(sorted.size() - 1, static_cast<size_t>(0.99 * sorted.size()))];
 }
 
-// With the old decision (chi2 > 100 alone) tilts of 0.13–0.19° were held at
-// level and every such frame was 5–7 mm off: p99 6.0 mm here. Measured
-// 2026-12-03 on these 150 frames: p99 2.21 mm, max 2.64 mm; every frame over
-// 1.7 mm is a free-tilt fit whose own sigma is ~3 mm (three collinear points
-// a marker tell the tilt poorly from the position), not a wrong decision.
+// Issue 25's limit: p99 <= 2 mm on tilted frames with 6 or more markers.
+// History on these 150 frames: 6.0 mm with the old decision (chi2 > 100
+// alone: tilts of 0.13-0.19 deg held at level); 2.21 mm once the decision
+// weighed the shift, where three collinear points a marker left the free
+// fit's own sigma at ~3 mm; measured 2026-12-04 with the rectangles' edge
+// points (rectangle_ends.h): p99 1.28 mm, max 1.49 mm.
 TEST(TiltDecision, ATiltedCameraWithSixOrMoreMarkersIsNotHeldAtLevel) {
   const int frames = testing::accuracy_frames(150);
   const TiltRun r = run(frames, false, 5);
   ASSERT_GE(r.errors_mm.size(), static_cast<size_t>(frames * 2 / 3));
-  EXPECT_LE(p99(r.errors_mm), 2.5);
-  EXPECT_LE(r.errors_mm.back(), 3.5);
+  EXPECT_LE(p99(r.errors_mm), 1.8);
+  EXPECT_LE(r.errors_mm.back(), 2.2);
   EXPECT_GE(r.free_chosen, static_cast<int>(r.errors_mm.size()) * 9 / 10);
 }
 
+// The same through a Pi camera's 4:2:0 chroma (NV12), another seed.
+// Measured: p99 1.66 mm, max 1.80 mm.
+TEST(TiltDecision, ATiltedNv12CameraWithSixOrMoreMarkersIsNotHeldAtLevel) {
+  const int frames = testing::accuracy_frames(150);
+  const TiltRun r = run(frames, false, 7, PixelFormat::kNv12);
+  ASSERT_GE(r.errors_mm.size(), static_cast<size_t>(frames * 2 / 3));
+  EXPECT_LE(p99(r.errors_mm), 2.0);
+  EXPECT_LE(r.errors_mm.back(), 2.5);
+}
+
 // The other side of the decision: a level camera must not "find" tilts.
-// Measured: 1 of 150 frames chose the free tilt (3.1 mm off), p99 0.50 mm.
+// Measured: no frame of 150 chose the free tilt, p99 0.31 mm (0.50 mm before
+// the edge points).
 TEST(TiltDecision, ALevelCameraKeepsTheTiltHeld) {
   const int frames = testing::accuracy_frames(150);
   const TiltRun r = run(frames, true, 5);
   ASSERT_GE(r.errors_mm.size(), static_cast<size_t>(frames * 2 / 3));
-  EXPECT_LE(r.free_chosen, 2);
-  EXPECT_LE(p99(r.errors_mm), 1.0);
+  EXPECT_LE(r.free_chosen, 1);
+  EXPECT_LE(p99(r.errors_mm), 0.5);
 }
 
 }  // namespace
