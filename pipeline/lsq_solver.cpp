@@ -48,7 +48,7 @@ bool LsqSolver::solve(const ViewGeometry& view, const PositioningParams& params,
   LsqVector b{};
   double wr2 = 0.0;
   int n = 0;
-  accumulate(view, params, points(), kept, fit.state, true, &a, &b, &wr2, &n);
+  accumulate(view, params, points(), kept, fit.state, fit.model, true, &a, &b, &wr2, &n);
   prior_cost(view, params, fit.model, fit.state, &a, &b);
   if (n < 2 * params.lsq_min_points) return false;  // two residuals a point
   const double rms = rms_px(view, kept, fit.state, n);
@@ -172,7 +172,11 @@ LsqSolver::Fit LsqSolver::choose_tilt_model(const ViewGeometry& view,
     out->tilt_choice = TiltChoice::kNotAllowed;
     return held;
   }
+  // From the held fit's pose, which is nearer the free optimum than the
+  // seed is (fewer iterations), with the seed's markers: the free model
+  // makes its own rejections.
   Fit free = seed;
+  if (std::isfinite(held.cost)) free.state = held.state;
   free.model.active[kLsqTiltX] = free.model.active[kLsqTiltY] = true;
   optimise(view, params, fixes, &free, iterations);
 
@@ -200,7 +204,7 @@ LsqSolver::Fit LsqSolver::choose_tilt_model(const ViewGeometry& view,
   double wr2 = 0.0;
   int n = 0;
   const std::span<const bool> free_use(free.use.data(), fixes.size());
-  accumulate(view, params, points(), free_use, free.state, false, &a, &b, &wr2, &n);
+  accumulate(view, params, points(), free_use, free.state, free.model, false, &a, &b, &wr2, &n);
   const double sigma2 = free.cost / std::max(1, n - free.model.free_count());
   out->tilt_chi2 = sigma2 > 0.0 ? (held.cost - free.cost) / sigma2 : 0.0;
   out->tilt_shift_m =
@@ -208,7 +212,7 @@ LsqSolver::Fit LsqSolver::choose_tilt_model(const ViewGeometry& view,
   const bool better = out->tilt_chi2 > params.lsq_tilt_select_chi2;
   bool matters = false;
   if (better) {
-    accumulate(view, params, points(), free_use, free.state, true, &a, &b, &wr2, &n);
+    accumulate(view, params, points(), free_use, free.state, free.model, true, &a, &b, &wr2, &n);
     prior_cost(view, params, free.model, free.state, &a, &b);
     out->tilt_free_sigma_m = position_sigma_m(free.model, a, wr2, n);
     matters = out->tilt_shift_m > params.lsq_tilt_select_shift_sigmas * out->tilt_free_sigma_m;
@@ -250,7 +254,7 @@ void LsqSolver::optimise(const ViewGeometry& view, const PositioningParams& para
   for (int pass = 0; pass <= params.lsq_max_rejections; ++pass) {
     fit->cost = INFINITY;
     double lambda = 1e-4;
-    double cost = accumulate(view, params, points(), use, st, true, &a, &b, &wr2, &n) +
+    double cost = accumulate(view, params, points(), use, st, fit->model, true, &a, &b, &wr2, &n) +
                   prior_cost(view, params, fit->model, st, &a, &b);
     if (!std::isfinite(cost)) return;
     for (int it = 0; it < params.lsq_max_iterations; ++it, ++*iterations) {
@@ -264,7 +268,7 @@ void LsqSolver::optimise(const ViewGeometry& view, const PositioningParams& para
       double twr2 = 0.0;
       int tn = 0;
       const double trial_cost =
-          accumulate(view, params, points(), use, trial, true, &ta, &tb, &twr2, &tn) +
+          accumulate(view, params, points(), use, trial, fit->model, true, &ta, &tb, &twr2, &tn) +
           prior_cost(view, params, fit->model, trial, &ta, &tb);
       if (trial_cost <= cost) {
         st = trial;

@@ -139,10 +139,16 @@ double residual2_px(const ViewGeometry& view, const LsqState& st, const LsqPoint
 
 double accumulate(const ViewGeometry& view, const PositioningParams& params,
                   std::span<const LsqPoint> points, std::span<const bool> use, const LsqState& st,
-                  bool with_jacobian, LsqNormal* a, LsqVector* b, double* sum_w_r2,
-                  int* residuals) {
+                  const LsqModel& model, bool with_jacobian, LsqNormal* a, LsqVector* b,
+                  double* sum_w_r2, int* residuals) {
   const double k = params.lsq_huber_px;
   const PointCamera centre = centre_camera(st);
+  // Only the free unknowns' rows and columns: a fit frees 4-6 of the 10, and
+  // the update is most of a point's cost.
+  int free[kN];
+  int free_n = 0;
+  for (int c = 0; c < kN; ++c)
+    if (model.active[c]) free[free_n++] = c;
   if (with_jacobian) {
     a->fill(0.0);
     b->fill(0.0);
@@ -162,14 +168,18 @@ double accumulate(const ViewGeometry& view, const PositioningParams& params,
     if (!with_jacobian) continue;
     double jx[kN], jy[kN];
     point_jacobian(view, pt, cam, jx, jy);
-    for (int r1 = 0; r1 < kN; ++r1) {
+    for (int i = 0; i < free_n; ++i) {
+      const int r1 = free[i];
       (*b)[r1] -= w * (jx[r1] * rx + jy[r1] * ry);
-      for (int c = r1; c < kN; ++c) (*a)[r1 * kN + c] += w * (jx[r1] * jx[c] + jy[r1] * jy[c]);
+      for (int j = i; j < free_n; ++j) {
+        const int c = free[j];
+        (*a)[r1 * kN + c] += w * (jx[r1] * jx[c] + jy[r1] * jy[c]);
+      }
     }
   }
   if (with_jacobian) {
-    for (int r1 = 0; r1 < kN; ++r1)
-      for (int c = 0; c < r1; ++c) (*a)[r1 * kN + c] = (*a)[c * kN + r1];
+    for (int i = 0; i < free_n; ++i)
+      for (int j = 0; j < i; ++j) (*a)[free[i] * kN + free[j]] = (*a)[free[j] * kN + free[i]];
   }
   *sum_w_r2 = wr2;
   *residuals = n;

@@ -102,13 +102,15 @@ void point_jacobian(const ViewGeometry& view, const LsqPoint& pt, const PointCam
 // Squared reprojection residual of one point, pixels².
 double residual2_px(const ViewGeometry& view, const LsqState& st, const LsqPoint& pt);
 
-// Huber-weighted normal equations (with_jacobian) and the robust cost of
-// the points whose marker is in use; infinite when a point is behind the
+// Huber-weighted normal equations (with_jacobian; the rows and columns of
+// the model's free unknowns, the rest zero) and the robust cost of the
+// points whose marker is in use; infinite when a point is behind the
 // camera. *sum_w_r2 and *residuals: the weighted squared residuals and how
 // many residuals there are (two a point, one an edge point).
 double accumulate(const ViewGeometry& view, const PositioningParams& params,
                   std::span<const LsqPoint> points, std::span<const bool> use, const LsqState& st,
-                  bool with_jacobian, LsqNormal* a, LsqVector* b, double* sum_w_r2, int* residuals);
+                  const LsqModel& model, bool with_jacobian, LsqNormal* a, LsqVector* b,
+                  double* sum_w_r2, int* residuals);
 
 // The priors' cost, added to the normal equations when `a` is given: the
 // motion towards the caller's (or rest), the tilt towards the mount's.

@@ -34,10 +34,10 @@ struct RectangleEdges {
   // The outer long side, half-way between neighbouring slots.
   std::array<EdgeCrossing, kMaxSideCrossings> side{};
   int side_count = 0;
-  // Blur along North at the ends, pixels (mean over the ends that measured
-  // one): the distance over which the darkest channel climbs from 25 % to
-  // 75 % of the way from the rectangle's level to the tile's on the
-  // rectangle's centre line. Negative: not measured.
+  // Blur along North at the ends, pixels (mean over the profiles that
+  // measured one): the distance over which the darkest channel climbs from
+  // 25 % to 75 % of the way from the rectangle's level to the tile's.
+  // Negative: not measured.
   double spread_px = -1.0;
 };
 
