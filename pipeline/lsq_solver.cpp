@@ -153,8 +153,9 @@ int LsqSolver::gather_points(const ViewGeometry& view, const PositioningParams& 
   return marker_count;
 }
 
-// 2. The tilt decision. Held tilt and free tilt are each fitted from the
-// seed with their own marker rejection. Tilt trades off against translation
+// 2. The tilt decision. Held tilt is fitted from the seed (and again once
+// the edge points are weighed against the centroids), free tilt from the
+// held fit's pose, each with its own marker rejection. Tilt trades off against translation
 // so closely that estimating it costs ~10x the position noise of holding it,
 // and on a ceiling whose markers are a little off their places a free tilt
 // "explains" the offsets by rejecting a good marker and moving the pose by
@@ -168,6 +169,7 @@ LsqSolver::Fit LsqSolver::choose_tilt_model(const ViewGeometry& view,
                                             int* iterations, LsqResult* out) {
   Fit held = seed;
   optimise(view, params, fixes, &held, iterations);
+  if (reweigh_edges(view, &held)) optimise(view, params, fixes, &held, iterations);
   if (!params.lsq_estimate_tilt || seed.markers < params.lsq_tilt_min_markers) {
     out->tilt_choice = TiltChoice::kNotAllowed;
     return held;
@@ -177,6 +179,7 @@ LsqSolver::Fit LsqSolver::choose_tilt_model(const ViewGeometry& view,
   // makes its own rejections.
   Fit free = seed;
   if (std::isfinite(held.cost)) free.state = held.state;
+  free.state.edge_weight = held.state.edge_weight;
   free.model.active[kLsqTiltX] = free.model.active[kLsqTiltY] = true;
   optimise(view, params, fixes, &free, iterations);
 
@@ -340,6 +343,36 @@ bool LsqSolver::motion_observable(const ViewGeometry& view, const PositioningPar
     hi = std::max(hi, pt.tau_s);
   }
   return hi - lo >= params.lsq_motion_min_row_span * readout_s;
+}
+
+// Edge points and centroids weighed by their own scatter in this frame: a
+// centroid averages hundreds of pixels, an edge point a dozen samples, so
+// noise, JPEG and blur move the second more. From the held fit's residuals
+// (per residual, each kind); true when the weight changed. Never above 1:
+// where edges scatter less, the centroids' systematic errors do not show in
+// their scatter. Stress set (noise sigma 6, JPEG 60, blur) 0.20 / 0.61 ->
+// 0.15 / 0.45 mm; tilted and level independent renders unchanged.
+bool LsqSolver::reweigh_edges(const ViewGeometry& view, Fit* fit) const {
+  if (!std::isfinite(fit->cost) || !fit->model.active[kLsqEdgeOffset]) return false;
+  LsqState st = fit->state;
+  st.edge_weight = 1.0;
+  double centroid_r2 = 0.0, edge_r2 = 0.0;
+  int centroid_n = 0, edge_n = 0;
+  for (const LsqPoint& pt : points()) {
+    if (!fit->use[pt.fix]) continue;
+    const double r2 = residual2_px(view, st, pt);
+    if (pt.is_edge()) {
+      edge_r2 += r2;
+      ++edge_n;
+    } else {
+      centroid_r2 += r2;
+      centroid_n += 2;
+    }
+  }
+  if (edge_n < 3 || centroid_n < 3 || !(edge_r2 > 0.0) || !(centroid_r2 > 0.0)) return false;
+  const double w = std::min(1.0, std::sqrt((centroid_r2 / centroid_n) / (edge_r2 / edge_n)));
+  fit->state.edge_weight = w;
+  return w < 1.0;
 }
 
 // Whether any marker in use has an edge point (else the edge offset has no

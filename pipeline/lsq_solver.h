@@ -100,6 +100,7 @@ class LsqSolver {
   bool motion_observable(const ViewGeometry& view, const PositioningParams& params,
                          std::span<const bool> use, int marker_count) const;
   bool edge_points_in_use(std::span<const bool> use) const;
+  bool reweigh_edges(const ViewGeometry& view, Fit* fit) const;
   double position_sigma_m(const LsqModel& model, const LsqNormal& a, double wr2, int n) const;
   double rms_px(const ViewGeometry& view, std::span<const bool> use, const LsqState& st,
                 int n) const;

@@ -30,9 +30,9 @@ void camera_at(const LsqState& st, double tau_s, Vec3* t_w, Mat3* r_wc) {
 
 // An edge point keeps only its residual's component across the edge, less
 // the edge offset (observed = projected + offset·normal).
-void across_edge(const LsqPoint& pt, double offset_px, double* x, double* y) {
+void across_edge(const LsqPoint& pt, double offset_px, double weight, double* x, double* y) {
   if (!pt.is_edge()) return;
-  *x = pt.normal_x * *x + pt.normal_y * *y - offset_px;
+  *x = weight * (pt.normal_x * *x + pt.normal_y * *y - offset_px);
   *y = 0.0;
 }
 
@@ -49,7 +49,8 @@ PointCamera centre_camera(const LsqState& st) {
   return {{},
           mat_transpose(st.r_wc),
           {{{0.0, 0.0, 1.0}, {lev[0], lev[3], lev[6]}, {lev[1], lev[4], lev[7]}}},
-          st.edge_offset_px};
+          st.edge_offset_px,
+          st.edge_weight};
 }
 
 PointCamera point_camera(const LsqState& st, const LsqPoint& pt, const PointCamera& centre,
@@ -80,7 +81,7 @@ bool point_residual(const ViewGeometry& view, const LsqPoint& pt, const PointCam
   if (p[2] < 1e-3) return false;
   *rx = normalized_residual_px(view.intrinsics().fx, pt.x_n, p[0], p[2]);
   *ry = normalized_residual_px(view.intrinsics().fy, pt.y_n, p[1], p[2]);
-  across_edge(pt, cam.edge_offset_px, rx, ry);
+  across_edge(pt, cam.edge_offset_px, cam.edge_weight, rx, ry);
   return true;
 }
 
@@ -121,8 +122,8 @@ void point_jacobian(const ViewGeometry& view, const LsqPoint& pt, const PointCam
   jy[kLsqYawRate] = pt.tau_s * jy[kLsqYaw];
   jx[kLsqEdgeOffset] = jy[kLsqEdgeOffset] = 0.0;
   if (!pt.is_edge()) return;
-  for (int c = 0; c < kN; ++c) across_edge(pt, 0.0, &jx[c], &jy[c]);
-  jx[kLsqEdgeOffset] = -1.0;
+  for (int c = 0; c < kN; ++c) across_edge(pt, 0.0, cam.edge_weight, &jx[c], &jy[c]);
+  jx[kLsqEdgeOffset] = -cam.edge_weight;
 }
 
 double residual2_px(const ViewGeometry& view, const LsqState& st, const LsqPoint& pt) {
@@ -133,7 +134,7 @@ double residual2_px(const ViewGeometry& view, const LsqState& st, const LsqPoint
                          {pt.world[0] - t_w[0], pt.world[1] - t_w[1], pt.world[2] - t_w[2]});
   double rx = normalized_residual_px(view.intrinsics().fx, pt.x_n, p[0], p[2]);
   double ry = normalized_residual_px(view.intrinsics().fy, pt.y_n, p[1], p[2]);
-  across_edge(pt, st.edge_offset_px, &rx, &ry);
+  across_edge(pt, st.edge_offset_px, st.edge_weight, &rx, &ry);
   return rx * rx + ry * ry;
 }
 

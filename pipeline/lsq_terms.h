@@ -59,6 +59,9 @@ struct LsqState {
   Mat3 r_wc{};                         // camera axes in the world
   double vx = 0.0, vy = 0.0, w = 0.0;  // optical centre velocity, yaw rate
   double edge_offset_px = 0.0;         // edge points' outward offset
+  // Not an unknown: the weight of an edge point's residual against a
+  // centroid's, from their scatter in this frame (lsq_solver.cpp).
+  double edge_weight = 1.0;
 };
 
 // Which unknowns a fit frees, and the motion it holds them at or draws them
@@ -78,6 +81,7 @@ struct PointCamera {
   Mat3 rt;
   std::array<Vec3, 3> axis;
   double edge_offset_px = 0.0;
+  double edge_weight = 1.0;
 };
 
 // The camera at the centre row: Rᵀ and the world directions of the yaw and
