@@ -11,9 +11,20 @@ namespace {
 using config_detail::Choices;
 using config_detail::TextCheck;
 
+// A YAML double-quoted scalar. Control characters are escaped: written raw,
+// a line break inside the quotes is folded to a space when read back (the
+// config fuzzer found a calibration_file holding one).
 std::string quoted(const std::string& s) {
   std::string out = "\"";
   for (char ch : s) {
+    const auto byte = static_cast<unsigned char>(ch);
+    if (byte < 0x20 || byte == 0x7f) {
+      static constexpr char kHex[] = "0123456789abcdef";
+      out += "\\x";
+      out += kHex[byte >> 4];
+      out += kHex[byte & 15];
+      continue;
+    }
     if (ch == '"' || ch == '\\') out += '\\';
     out += ch;
   }

@@ -27,6 +27,19 @@ TEST(ConfigLoader, EmptyTextGivesDefaults) {
   EXPECT_EQ(dump_config(*r), dump_config(default_config()));
 }
 
+// A text value holding control characters (a double-quoted YAML scalar
+// folds an empty line to a line break) is dumped escaped, and reads back
+// the same: raw, the break came back as a space (found by fuzz_config).
+TEST(ConfigLoader, ATextWithALineBreakDumpsAndLoadsTheSame) {
+  const auto r = load_config_string("camera:\n  calibration_file: \"a b\n\n  c\\td\"\n", "t.yaml");
+  ASSERT_TRUE(r) << r.error().message;
+  const std::string dumped = dump_config(*r);
+  EXPECT_NE(dumped.find("\\x0a"), std::string::npos) << dumped;
+  const auto again = load_config_string(dumped, "dumped.yaml");
+  ASSERT_TRUE(again) << again.error().message;
+  EXPECT_EQ(config_values(*again), config_values(*r));
+}
+
 TEST(ConfigLoader, KeyOverridesOnlyItself) {
   auto r = load_config_string("camera:\n  fx: 600.5\n", "t.yaml");
   ASSERT_TRUE(r) << r.error().message;
