@@ -62,10 +62,10 @@ Result<void> DdsFleetListener::take_publications() {
     entry.robot.topic = t.topic;
     entry.robot.type_name = t.type_name;
     entry.robot.xcdr1 = t.xcdr1;
-    // Best effort, keep the latest only: the listing shows where robots are.
-    auto reader = create_fleet_reader(participant_.handle(), waitset_,
-                                      &geometry_msgs_msg_dds__PoseWithCovarianceStamped__desc,
-                                      t.topic, false, 1);
+    // Keep the latest only: the listing shows where robots are.
+    auto reader =
+        create_fleet_reader(participant_.handle(), waitset_,
+                            &geometry_msgs_msg_dds__PoseWithCovarianceStamped__desc, t.topic, 1);
     if (!reader) return reader.error();
     entry.reader = *reader;
     entries_.emplace(entry.robot.topic, std::move(entry));

@@ -77,7 +77,7 @@ Result<void> DdsFleetSubscriber::poll(int64_t timeout_ms, FleetSampleSink* sink)
         dds_create_listener(&entry), &dds_delete_listener);
     dds_lset_data_available(listener.get(), &DdsFleetSubscriber::on_data_available);
     auto reader = create_fleet_reader(participant_, waitset_, &ceilpose_msg_dds__State__desc,
-                                      t.topic, true, depth_, listener.get());
+                                      t.topic, depth_, listener.get());
     if (!reader) {
       readers_.erase(it);
       // Under DDS Security, access control refuses a reader the permissions

@@ -71,17 +71,17 @@ Result<void> DdsTopicDiscovery::take_new(std::vector<DiscoveredTopic>* found) {
 
 Result<dds_entity_t> create_fleet_reader(dds_entity_t participant, dds_entity_t waitset,
                                          const dds_topic_descriptor_t* descriptor,
-                                         const std::string& topic, bool reliable, int32_t depth,
+                                         const std::string& topic, int32_t depth,
                                          const dds_listener_t* listener) {
   const dds_entity_t t = dds_create_topic(participant, descriptor, topic.c_str(), nullptr, nullptr);
   if (t < 0) return dds_error("cannot create DDS topic " + topic, t);
   DdsQos qos = make_dds_qos();
-  if (reliable) {
-    dds_qset_reliability(qos.get(), DDS_RELIABILITY_RELIABLE, DDS_MSECS(100));
-  } else {
-    // Best-effort readers match reliable and best-effort writers alike.
-    dds_qset_reliability(qos.get(), DDS_RELIABILITY_BEST_EFFORT, 0);
-  }
+  // Best effort: only the latest pose matters, and a retransmitted one would
+  // arrive behind the next sample (33 ms later) and hold it up. A best-effort
+  // reader matches reliable and best-effort writers alike, and sends no
+  // acknowledgements: at 50 robots that halved the observer's packets
+  // (docs/fleet.md, session 22).
+  dds_qset_reliability(qos.get(), DDS_RELIABILITY_BEST_EFFORT, 0);
   dds_qset_history(qos.get(), DDS_HISTORY_KEEP_LAST, depth);
   const std::array<dds_data_representation_id_t, 2> representations{DDS_DATA_REPRESENTATION_XCDR1,
                                                                     DDS_DATA_REPRESENTATION_XCDR2};

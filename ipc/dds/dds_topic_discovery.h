@@ -41,13 +41,13 @@ class DdsTopicDiscovery {
   std::set<std::string> seen_;
 };
 
-// A reader of `topic` for the latest samples: `depth` kept per instance,
-// reliable or best effort, accepting XCDR1 and XCDR2. Its data wakes
+// A best-effort reader of `topic` for the latest samples: `depth` kept per
+// instance, accepting XCDR1 and XCDR2. Its data wakes
 // `waitset`, or, given a `listener`, calls that listener instead (in DDS's
 // receive thread, with no thread to wake). The error names the topic.
 Result<dds_entity_t> create_fleet_reader(dds_entity_t participant, dds_entity_t waitset,
                                          const dds_topic_descriptor_t* descriptor,
-                                         const std::string& topic, bool reliable, int32_t depth,
+                                         const std::string& topic, int32_t depth,
                                          const dds_listener_t* listener = nullptr);
 
 }  // namespace ceilpose

@@ -111,7 +111,7 @@ TEST_F(KeystoreTest, PermissionsLetARobotPublishOnlyItsOwnTopicsAndReadEveryRobo
   for (const char* rule :
        {"<allow_unauthenticated_participants>false<", "<enable_join_access_control>true<",
         "<discovery_protection_kind>ENCRYPT<", "<liveliness_protection_kind>ENCRYPT<",
-        "<data_protection_kind>ENCRYPT<"}) {
+        "<metadata_protection_kind>ENCRYPT<", "<data_protection_kind>ENCRYPT<"}) {
     EXPECT_NE(governance.find(rule), std::string::npos) << rule;
   }
 }
