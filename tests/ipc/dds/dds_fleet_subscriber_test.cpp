@@ -14,7 +14,9 @@
 #include <thread>
 
 #include "core/clock.h"
+#include "ipc/dds/dds_messages.h"
 #include "ipc/dds/dds_pose_publisher.h"
+#include "ipc/dds/dds_topic_discovery.h"
 #include "tests/ipc/dds/dds_test_env.h"
 #include "tests/ipc/fleet/fleet_test_support.h"
 
@@ -55,6 +57,33 @@ bool wait_for(const std::function<bool()>& done, std::chrono::milliseconds limit
     std::this_thread::sleep_for(std::chrono::milliseconds(5));
   }
   return true;
+}
+
+// The fleet reads best effort, keep-last `depth` (docs/decisions.md, issue
+// 26): a retransmitted pose would arrive behind the next one, and the
+// acknowledgements cost the observer of 50 robots its CPU budget.
+TEST(DdsFleetReader, IsBestEffortAndKeepsTheLatestDepthSamples) {
+  test::use_loopback_dds();
+  const dds_entity_t participant =
+      dds_create_participant(test::unique_domain_id(), nullptr, nullptr);
+  ASSERT_GT(participant, 0);
+  const dds_entity_t waitset = dds_create_waitset(participant);
+  const auto reader = create_fleet_reader(participant, waitset, &ceilpose_msg_dds__State__desc,
+                                          "rt/somebody/ceilpose_state", 8);
+  ASSERT_TRUE(reader) << reader.error().message;
+  dds_qos_t* qos = dds_create_qos();
+  ASSERT_EQ(dds_get_qos(*reader, qos), DDS_RETCODE_OK);
+  dds_reliability_kind_t reliability{};
+  dds_duration_t blocking = 0;
+  ASSERT_TRUE(dds_qget_reliability(qos, &reliability, &blocking));
+  EXPECT_EQ(reliability, DDS_RELIABILITY_BEST_EFFORT);
+  dds_history_kind_t history{};
+  int32_t depth = 0;
+  ASSERT_TRUE(dds_qget_history(qos, &history, &depth));
+  EXPECT_EQ(history, DDS_HISTORY_KEEP_LAST);
+  EXPECT_EQ(depth, 8);
+  dds_delete_qos(qos);
+  dds_delete(participant);
 }
 
 TEST(DdsFleetSubscriberTest, SamplesArriveWithoutPollingOnceARobotIsFoundAndNoneAfterStop) {
