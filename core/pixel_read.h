@@ -6,6 +6,7 @@
 // place coloured edges, interpolate chroma between pairs instead
 // (pipeline/components.cpp).
 #include <algorithm>
+#include <array>
 #include <cstdint>
 
 #include "core/image.h"
@@ -52,6 +53,60 @@ inline void read_rgb(const ImageView& f, int x, int y, uint8_t* r, uint8_t* g, u
       break;
   }
   *r = *g = *b = 0;
+}
+
+// One pixel's red, green and blue levels.
+struct Rgb8 {
+  uint8_t r = 0, g = 0, b = 0;
+};
+
+// Pixels (x, y), (x + 1, y), (x, y + 1), (x + 1, y + 1), in that order, each
+// as read_rgb gives it, with one dispatch on the format for the four: a
+// bilinear sample needs them, and dot slots and rectangle edges take
+// thousands of samples a frame.
+inline void read_rgb_2x2(const ImageView& f, int x, int y, std::array<Rgb8, 4>* out) {
+  std::array<Rgb8, 4>& o = *out;
+  switch (f.format) {
+    case PixelFormat::kRgb24:
+    case PixelFormat::kBgr24: {
+      const int red = f.format == PixelFormat::kRgb24 ? 0 : 2;
+      for (int k = 0; k < 4; ++k) {
+        const uint8_t* p = f.row(y + (k >> 1)) + 3 * (x + (k & 1));
+        o[k] = {p[red], p[1], p[2 - red]};
+      }
+      return;
+    }
+    case PixelFormat::kYuyv:
+      for (int k = 0; k < 4; ++k) {
+        const int xk = x + (k & 1);
+        const uint8_t* q = f.row(y + (k >> 1)) + 4 * (xk / 2);
+        yuv_to_rgb(q[(xk & 1) * 2], q[1], q[3], &o[k].r, &o[k].g, &o[k].b);
+      }
+      return;
+    case PixelFormat::kNv12:
+      for (int k = 0; k < 4; ++k) {
+        const int xk = x + (k & 1), yk = y + (k >> 1);
+        const uint8_t* uv = f.uv_row(yk) + (xk & ~1);
+        yuv_to_rgb(f.row(yk)[xk], uv[0], uv[1], &o[k].r, &o[k].g, &o[k].b);
+      }
+      return;
+    case PixelFormat::kYuv420:
+      for (int k = 0; k < 4; ++k) {
+        const int xk = x + (k & 1), yk = y + (k >> 1);
+        yuv_to_rgb(f.row(yk)[xk], f.u_row(yk)[xk / 2], f.v_row(yk)[xk / 2], &o[k].r, &o[k].g,
+                   &o[k].b);
+      }
+      return;
+    case PixelFormat::kGray8:
+      for (int k = 0; k < 4; ++k) {
+        const uint8_t v = f.row(y + (k >> 1))[x + (k & 1)];
+        o[k] = {v, v, v};
+      }
+      return;
+    case PixelFormat::kMjpeg:
+      break;
+  }
+  o.fill(Rgb8{});
 }
 
 // Chroma is sampled once per pixel pair (and per row pair in 4:2:0),

@@ -40,9 +40,10 @@ Brightness brightness_at(const ImageView& frame, double u, double v) {
   const double fu = u - x0, fv = v - y0;
   const double w[4] = {(1 - fu) * (1 - fv), fu * (1 - fv), (1 - fu) * fv, fu * fv};
   Brightness out{0.0, 0.0};
+  std::array<Rgb8, 4> px;
+  read_rgb_2x2(frame, x0, y0, &px);
   for (int k = 0; k < 4; ++k) {
-    uint8_t r = 0, g = 0, b = 0;
-    read_rgb(frame, x0 + (k & 1), y0 + (k >> 1), &r, &g, &b);
+    const auto [r, g, b] = px[k];
     out[0] += w[k] * std::max({r, g, b});
     out[1] += w[k] * (0.299 * r + 0.587 * g + 0.114 * b);
   }
