@@ -5,15 +5,12 @@
 #include <cstdint>
 
 #include "core/camera_model.h"
+#include "core/image.h"
 
 namespace ceilpose {
 
 inline constexpr double kInch_m = 0.0254;
 inline constexpr int kMaxBits = 8;
-
-struct Rgb {
-  uint8_t r, g, b;
-};
 
 struct CeilingLayout {
   double height_m = 2.4384;  // ceiling plane z = H

@@ -14,6 +14,11 @@ namespace ceilpose {
 // (height+1)/2 rows of interleaved U, V bytes with the luma's stride; YUV420
 // (I420) a U plane then a V plane of (height+1)/2 rows of stride_bytes/2.
 // Both hold stride_bytes x (height + (height+1)/2) bytes; width is even.
+// One pixel's red, green and blue levels.
+struct Rgb {
+  uint8_t r, g, b;
+};
+
 enum class PixelFormat : uint8_t { kGray8, kRgb24, kBgr24, kYuyv, kMjpeg, kNv12, kYuv420 };
 
 // Bytes per pixel of a row; for the 4:2:0 formats, of the luma plane's row.

@@ -22,91 +22,76 @@ inline void yuv_to_rgb(int y, int u, int v, uint8_t* r, uint8_t* g, uint8_t* b) 
   *b = static_cast<uint8_t>(std::clamp((c + 516 * d) >> 8, 0, 255));
 }
 
-// RGB of pixel (x, y) in any uncompressed format; grey gives r = g = b.
-// For sparse reads only (white sample, dot slots), not for full-frame sweeps.
-inline void read_rgb(const ImageView& f, int x, int y, uint8_t* r, uint8_t* g, uint8_t* b) {
+// RGB of pixel (x, y) of a frame in format F (not MJPEG); grey gives
+// r = g = b. The one formula per format that read_rgb and read_rgb_2x2 share.
+template <PixelFormat F>
+inline Rgb pixel_rgb(const ImageView& f, int x, int y) {
   const uint8_t* p = f.row(y);
-  switch (f.format) {
+  Rgb c{0, 0, 0};
+  if constexpr (F == PixelFormat::kRgb24) {
+    c = {p[3 * x], p[3 * x + 1], p[3 * x + 2]};
+  } else if constexpr (F == PixelFormat::kBgr24) {
+    c = {p[3 * x + 2], p[3 * x + 1], p[3 * x]};
+  } else if constexpr (F == PixelFormat::kYuyv) {
+    const uint8_t* q = p + 4 * (x / 2);
+    yuv_to_rgb(q[(x & 1) * 2], q[1], q[3], &c.r, &c.g, &c.b);
+  } else if constexpr (F == PixelFormat::kNv12) {
+    const uint8_t* uv = f.uv_row(y) + (x & ~1);
+    yuv_to_rgb(p[x], uv[0], uv[1], &c.r, &c.g, &c.b);
+  } else if constexpr (F == PixelFormat::kYuv420) {
+    yuv_to_rgb(p[x], f.u_row(y)[x / 2], f.v_row(y)[x / 2], &c.r, &c.g, &c.b);
+  } else if constexpr (F == PixelFormat::kGray8) {
+    c = {p[x], p[x], p[x]};
+  }
+  return c;
+}
+
+// Calls fn(pixel_rgb<F>) for the frame's format F; false for MJPEG (no
+// pixels to read).
+template <typename Fn>
+inline bool with_pixel_reader(PixelFormat format, Fn&& fn) {
+  switch (format) {
     case PixelFormat::kRgb24:
-      *r = p[3 * x], *g = p[3 * x + 1], *b = p[3 * x + 2];
-      return;
+      fn(pixel_rgb<PixelFormat::kRgb24>);
+      return true;
     case PixelFormat::kBgr24:
-      *b = p[3 * x], *g = p[3 * x + 1], *r = p[3 * x + 2];
-      return;
-    case PixelFormat::kYuyv: {
-      const uint8_t* q = p + 4 * (x / 2);
-      yuv_to_rgb(q[(x & 1) * 2], q[1], q[3], r, g, b);
-      return;
-    }
-    case PixelFormat::kNv12: {
-      const uint8_t* uv = f.uv_row(y) + (x & ~1);
-      yuv_to_rgb(p[x], uv[0], uv[1], r, g, b);
-      return;
-    }
+      fn(pixel_rgb<PixelFormat::kBgr24>);
+      return true;
+    case PixelFormat::kYuyv:
+      fn(pixel_rgb<PixelFormat::kYuyv>);
+      return true;
+    case PixelFormat::kNv12:
+      fn(pixel_rgb<PixelFormat::kNv12>);
+      return true;
     case PixelFormat::kYuv420:
-      yuv_to_rgb(p[x], f.u_row(y)[x / 2], f.v_row(y)[x / 2], r, g, b);
-      return;
+      fn(pixel_rgb<PixelFormat::kYuv420>);
+      return true;
     case PixelFormat::kGray8:
-      *r = *g = *b = p[x];
-      return;
+      fn(pixel_rgb<PixelFormat::kGray8>);
+      return true;
     case PixelFormat::kMjpeg:
       break;
   }
-  *r = *g = *b = 0;
+  return false;
 }
 
-// One pixel's red, green and blue levels.
-struct Rgb8 {
-  uint8_t r = 0, g = 0, b = 0;
-};
+// RGB of pixel (x, y) in any uncompressed format; grey gives r = g = b.
+// For sparse reads only (white sample, dot slots), not for full-frame sweeps.
+inline void read_rgb(const ImageView& f, int x, int y, uint8_t* r, uint8_t* g, uint8_t* b) {
+  Rgb c{0, 0, 0};
+  with_pixel_reader(f.format, [&](auto read) { c = read(f, x, y); });
+  *r = c.r, *g = c.g, *b = c.b;
+}
 
 // Pixels (x, y), (x + 1, y), (x, y + 1), (x + 1, y + 1), in that order, each
 // as read_rgb gives it, with one dispatch on the format for the four: a
 // bilinear sample needs them, and dot slots and rectangle edges take
 // thousands of samples a frame.
-inline void read_rgb_2x2(const ImageView& f, int x, int y, std::array<Rgb8, 4>* out) {
-  std::array<Rgb8, 4>& o = *out;
-  switch (f.format) {
-    case PixelFormat::kRgb24:
-    case PixelFormat::kBgr24: {
-      const int red = f.format == PixelFormat::kRgb24 ? 0 : 2;
-      for (int k = 0; k < 4; ++k) {
-        const uint8_t* p = f.row(y + (k >> 1)) + 3 * (x + (k & 1));
-        o[k] = {p[red], p[1], p[2 - red]};
-      }
-      return;
-    }
-    case PixelFormat::kYuyv:
-      for (int k = 0; k < 4; ++k) {
-        const int xk = x + (k & 1);
-        const uint8_t* q = f.row(y + (k >> 1)) + 4 * (xk / 2);
-        yuv_to_rgb(q[(xk & 1) * 2], q[1], q[3], &o[k].r, &o[k].g, &o[k].b);
-      }
-      return;
-    case PixelFormat::kNv12:
-      for (int k = 0; k < 4; ++k) {
-        const int xk = x + (k & 1), yk = y + (k >> 1);
-        const uint8_t* uv = f.uv_row(yk) + (xk & ~1);
-        yuv_to_rgb(f.row(yk)[xk], uv[0], uv[1], &o[k].r, &o[k].g, &o[k].b);
-      }
-      return;
-    case PixelFormat::kYuv420:
-      for (int k = 0; k < 4; ++k) {
-        const int xk = x + (k & 1), yk = y + (k >> 1);
-        yuv_to_rgb(f.row(yk)[xk], f.u_row(yk)[xk / 2], f.v_row(yk)[xk / 2], &o[k].r, &o[k].g,
-                   &o[k].b);
-      }
-      return;
-    case PixelFormat::kGray8:
-      for (int k = 0; k < 4; ++k) {
-        const uint8_t v = f.row(y + (k >> 1))[x + (k & 1)];
-        o[k] = {v, v, v};
-      }
-      return;
-    case PixelFormat::kMjpeg:
-      break;
-  }
-  o.fill(Rgb8{});
+inline void read_rgb_2x2(const ImageView& f, int x, int y, std::array<Rgb, 4>* out) {
+  out->fill(Rgb{0, 0, 0});
+  with_pixel_reader(f.format, [&](auto read) {
+    for (int k = 0; k < 4; ++k) (*out)[k] = read(f, x + (k & 1), y + (k >> 1));
+  });
 }
 
 // Chroma is sampled once per pixel pair (and per row pair in 4:2:0),

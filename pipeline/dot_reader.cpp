@@ -40,7 +40,7 @@ Brightness brightness_at(const ImageView& frame, double u, double v) {
   const double fu = u - x0, fv = v - y0;
   const double w[4] = {(1 - fu) * (1 - fv), fu * (1 - fv), (1 - fu) * fv, fu * fv};
   Brightness out{0.0, 0.0};
-  std::array<Rgb8, 4> px;
+  std::array<Rgb, 4> px;
   read_rgb_2x2(frame, x0, y0, &px);
   for (int k = 0; k < 4; ++k) {
     const auto [r, g, b] = px[k];

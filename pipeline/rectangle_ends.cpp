@@ -33,7 +33,7 @@ double darkest_at(const ImageView& frame, double u, double v) {
   const int x0 = static_cast<int>(std::floor(u)), y0 = static_cast<int>(std::floor(v));
   if (x0 < 0 || y0 < 0 || x0 + 1 >= frame.width || y0 + 1 >= frame.height) return -1.0;
   const double fu = u - x0, fv = v - y0;
-  std::array<Rgb8, 4> px;
+  std::array<Rgb, 4> px;
   read_rgb_2x2(frame, x0, y0, &px);
   double corner[4];
   for (int c = 0; c < 4; ++c) corner[c] = std::min({px[c].r, px[c].g, px[c].b});

@@ -21,7 +21,7 @@ TEST(PixelRead, TwoByTwoBlocksAreReadRgbOfTheirFourPixelsInEveryFormat) {
     const ImageView view = image.view();
     for (int y = 0; y + 1 < view.height; ++y) {
       for (int x = 0; x + 1 < view.width; ++x) {
-        std::array<Rgb8, 4> block;
+        std::array<Rgb, 4> block;
         read_rgb_2x2(view, x, y, &block);
         for (int k = 0; k < 4; ++k) {
           uint8_t r = 0, g = 0, b = 0;
