@@ -399,6 +399,19 @@ bool ComponentLabeler::label(const ImageView& frame, const ColorClassifier& clas
     }
     pixels += w.area_px();
   }
+  // A camera's frame arrives in memory, not in cache, and a window's span
+  // (a few hundred bytes a row, a dozen places a row) is too short a stream
+  // for the hardware prefetcher: asked for all at once, before the sweep,
+  // the windows' pixels cost a tracked 640x480 RGB frame ~60 us less
+  // (docs/pipeline_speed.md).
+  if (frame.width == width_ && frame.height == height_ && !frame.empty() &&
+      frame.format != PixelFormat::kGray8) {
+    for (const PixelWindow& w : windows)
+      for (int y = w.y0; y <= w.y1; ++y) {
+        int x0 = 0, x1 = 0;
+        if (w.row_span(y, &x0, &x1)) prefetch_pixels(frame, y, x0, x1);
+      }
+  }
   run_budget_ = std::min(max_runs_, std::max(1024, static_cast<int>(static_cast<double>(pixels) *
                                                                     params_.max_runs_per_pixel)));
   return sweep_rows(frame, classifier, windows);
