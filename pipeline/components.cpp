@@ -29,6 +29,9 @@ namespace ceilpose {
 namespace {
 
 constexpr size_t kRowPadding = 8;
+// Windows side by side that a sweep's span table holds without growing
+// (a tracked frame has one per marker in view, a dozen).
+constexpr size_t kReservedSpansPerRow = 32;
 
 // x86-64's baseline (SSE2) has no 32-bit vector multiply, so the BT.601
 // arithmetic is also compiled for AVX2 and picked at load time where the
@@ -145,6 +148,8 @@ void ComponentLabeler::resize(int width_px, int height_px) {
   for (auto* v : {&pair_u_, &pair_v_}) v->assign(pairs_padded, 0);
   for (auto* v : {&px_y_, &px_u_, &px_v_}) v->assign(pixels_padded, 0);
   for (auto* v : {&px_r_, &px_g_, &px_b_}) v->assign(pixels_padded, 0);
+  spans_.resize(static_cast<size_t>(height_) * kReservedSpansPerRow);
+  swept_.reserve(kReservedSpansPerRow);
   runs_.resize(static_cast<size_t>(max_runs_) + 1);
   parent_.resize(runs_.size());
   label_.resize(runs_.size());
@@ -385,40 +390,72 @@ void ComponentLabeler::accumulate() {
 bool ComponentLabeler::label(const ImageView& frame, const ColorClassifier& classifier) {
   const PixelWindow whole{0, 0, width_ - 1, height_ - 1};
   run_budget_ = max_runs_;
-  return sweep_rows(frame, classifier, std::span<const PixelWindow>(&whole, 1));
+  plan_spans(frame, std::span<const PixelWindow>(&whole, 1), false);
+  return sweep_rows(frame, classifier);
 }
 
 bool ComponentLabeler::label(const ImageView& frame, const ColorClassifier& classifier,
                              std::span<const PixelWindow> windows) {
+  auto refuse = [&] {
+    run_count_ = 0;
+    comp_count_ = 0;
+    return false;
+  };
   int64_t pixels = 0;
-  for (const PixelWindow& w : windows) {
-    if (w.empty() || w.x0 < 0 || w.y0 < 0 || w.x1 >= width_ || w.y1 >= height_) {
-      run_count_ = 0;
-      comp_count_ = 0;
-      return false;
+  for (size_t i = 0; i < windows.size(); ++i) {
+    const PixelWindow& w = windows[i];
+    if (w.empty() || w.x0 < 0 || w.y0 < 0 || w.x1 >= width_ || w.y1 >= height_) return refuse();
+    // Boxes apart, as merge_windows leaves them: each row's spans are then
+    // apart and in the order of the boxes' left edges.
+    for (size_t j = 0; j < i; ++j) {
+      const PixelWindow& o = windows[j];
+      if (w.x0 <= o.x1 + 1 && o.x0 <= w.x1 + 1 && w.y0 <= o.y1 + 1 && o.y0 <= w.y1 + 1)
+        return refuse();
     }
     pixels += w.area_px();
   }
+  run_budget_ = std::min(max_runs_, std::max(1024, static_cast<int>(static_cast<double>(pixels) *
+                                                                    params_.max_runs_per_pixel)));
+  plan_spans(frame, windows, true);
+  return sweep_rows(frame, classifier);
+}
+
+void ComponentLabeler::plan_spans(const ImageView& frame, std::span<const PixelWindow> windows,
+                                  bool prefetch) {
+  swept_.clear();
+  size_t span_count = 0;
+  for (const PixelWindow& w : windows) {
+    // Left edges in increasing order (windows are few: insertion).
+    auto at = swept_.begin();
+    while (at != swept_.end() && at->x0 < w.x0) ++at;
+    swept_.insert(at, SweptWindow{w.x0, w.y0, w.y1, static_cast<int32_t>(&w - windows.data()), 0});
+    span_count += static_cast<size_t>(w.y1 - w.y0 + 1);
+  }
+  if (spans_.size() < span_count) spans_.resize(span_count);  // more windows than reserved
   // A camera's frame arrives in memory, not in cache, and a window's span
   // (a few hundred bytes a row, a dozen places a row) is too short a stream
   // for the hardware prefetcher: asked for all at once, before the sweep,
   // the windows' pixels cost a tracked 640x480 RGB frame ~60 us less
-  // (docs/pipeline_speed.md).
-  if (frame.width == width_ && frame.height == height_ && !frame.empty() &&
-      frame.format != PixelFormat::kGray8) {
-    for (const PixelWindow& w : windows)
-      for (int y = w.y0; y <= w.y1; ++y) {
-        int x0 = 0, x1 = 0;
-        if (w.row_span(y, &x0, &x1)) prefetch_pixels(frame, y, x0, x1);
+  // (docs/pipeline_speed.md). A whole sweep reads in address order and
+  // needs no help.
+  const bool ask = prefetch && frame.width == width_ && frame.height == height_ &&
+                   !frame.empty() && frame.format != PixelFormat::kGray8;
+  int32_t first = 0;
+  for (SweptWindow& sw : swept_) {
+    const PixelWindow& w = windows[static_cast<size_t>(sw.window)];
+    sw.first_span = first;
+    for (int y = sw.y0; y <= sw.y1; ++y) {
+      RowSpan& span = spans_[static_cast<size_t>(first++)];
+      if (!w.row_span(y, &span.x0, &span.x1)) {
+        span = RowSpan{};
+        continue;
       }
+      if (ask) prefetch_pixels(frame, y, span.x0, span.x1);
+    }
   }
-  run_budget_ = std::min(max_runs_, std::max(1024, static_cast<int>(static_cast<double>(pixels) *
-                                                                    params_.max_runs_per_pixel)));
-  return sweep_rows(frame, classifier, windows);
 }
 
-bool ComponentLabeler::sweep_rows(const ImageView& frame, const ColorClassifier& classifier,
-                                  std::span<const PixelWindow> windows) {
+bool ComponentLabeler::sweep_rows(const ImageView& frame, const ColorClassifier& classifier) {
   run_count_ = 0;
   comp_count_ = 0;
   window_cuts_ = 0;
@@ -427,46 +464,44 @@ bool ComponentLabeler::sweep_rows(const ImageView& frame, const ColorClassifier&
   // Grey frames carry no colour: nothing can be red or green.
   if (frame.format == PixelFormat::kGray8 || frame.format == PixelFormat::kMjpeg) return true;
   int y_begin = height_, y_end = -1;
-  for (const PixelWindow& w : windows) {
+  for (const SweptWindow& w : swept_) {
     y_begin = std::min(y_begin, w.y0);
     y_end = std::max(y_end, w.y1);
   }
-  // A run that starts or ends on a window's edge may continue beyond it
-  // (the frame's own edges are accumulate()'s): row_edge_ marks those
-  // pixels, and the whole span on a window's first and last row.
-  bool marked = false;
-  auto mark_edge = [&](int x) {
-    if (x > 0 && x < width_ - 1) row_edge_[x] = 1, marked = true;
-  };
   int prev_begin = 0, prev_end = 0;
   for (int y = y_begin; y <= y_end; ++y) {
-    int lo = width_, hi = -1;
-    for (const PixelWindow& w : windows) {
-      int x0 = 0, x1 = 0;
-      if (!w.row_span(y, &x0, &x1)) continue;
+    const int cur_begin = run_count_;
+    for (const SweptWindow& w : swept_) {
+      if (y < w.y0 || y > w.y1) continue;
+      const RowSpan span = spans_[static_cast<size_t>(w.first_span + (y - w.y0))];
+      if (span.x1 < span.x0) continue;
+      const int x0 = span.x0, x1 = span.x1;
+      const size_t n = static_cast<size_t>(x1 - x0 + 1);
       classify_span(frame, y, x0, x1, classifier);
       swept_px_ += x1 - x0 + 1;
-      // A quadrilateral's first and last rows are its box's (plan_tracking
+      // A run that starts or ends on a window's edge may continue beyond it
+      // (the frame's own edges are accumulate()'s): row_edge_ marks those
+      // pixels, and the whole span on a window's first and last row. A
+      // quadrilateral's first and last rows are its box's (plan_tracking
       // makes the box from it); a blob at its pointed ends also meets its
-      // slanted sides, which mark_edge marks.
+      // slanted sides, which the span's ends mark.
       const bool cap = (y == w.y0 && y > 0) || (y == w.y1 && y < height_ - 1);
       if (cap) {
-        std::memset(row_edge_.data() + x0, 1, static_cast<size_t>(x1 - x0 + 1));
-        marked = true;
+        std::memset(row_edge_.data() + x0, 1, n);
       } else {
-        mark_edge(x0);
-        mark_edge(x1);
+        for (const int x : {x0, x1})
+          if (x > 0 && x < width_ - 1) row_edge_[x] = 1;
       }
-      lo = std::min(lo, x0);
-      hi = std::max(hi, x1);
-    }
-    const int cur_begin = run_count_;
-    if (hi >= lo) {
-      const bool ok = encode_row(y, lo, hi);
+      // Spans are apart (boxes apart): each is encoded alone, in x order.
+      const bool ok = encode_row(y, x0, x1);
       // Outside the spans the buffers stay zero (encode_row relies on it).
-      std::memset(row_class_.data() + lo, 0, static_cast<size_t>(hi - lo + 1));
-      if (marked) std::memset(row_edge_.data() + lo, 0, static_cast<size_t>(hi - lo + 1));
-      marked = false;
+      std::memset(row_class_.data() + x0, 0, n);
+      if (cap) {
+        std::memset(row_edge_.data() + x0, 0, n);
+      } else {
+        row_edge_[x0] = 0;
+        row_edge_[x1] = 0;
+      }
       if (!ok) {
         run_count_ = 0;
         return false;

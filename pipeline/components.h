@@ -64,7 +64,8 @@ class ComponentLabeler {
   // no colour and give no components. Hot path: no allocation.
   bool label(const ImageView& frame, const ColorClassifier& classifier);
   // The same, within `windows` only (a tracked sweep): they must lie inside
-  // the frame and not overlap (merge_windows); the run budget is that of
+  // the frame, their boxes neither overlapping nor touching (merge_windows),
+  // else false and no components; the run budget is that of
   // the windows' pixels. A component on a window's edge touches_border.
   // The hot path of tracking: no allocation.
   bool label(const ImageView& frame, const ColorClassifier& classifier,
@@ -90,9 +91,11 @@ class ComponentLabeler {
                      const ColorClassifier& classifier);
   void classify_yuv_span(const ImageView& frame, int y, int x0, int x1,
                          const ColorClassifier& classifier);
+  // Row spans of every window, computed once per sweep (and, for a tracked
+  // sweep, their pixels asked for); windows in the order of their left edges.
+  void plan_spans(const ImageView& frame, std::span<const PixelWindow> windows, bool prefetch);
   bool encode_row(int y, int x0, int x1);
-  bool sweep_rows(const ImageView& frame, const ColorClassifier& classifier,
-                  std::span<const PixelWindow> windows);
+  bool sweep_rows(const ImageView& frame, const ColorClassifier& classifier);
   void join_rows(int prev_begin, int prev_end, int cur_begin, int cur_end);
   int32_t find(int32_t i);
   void unite(int32_t a, int32_t b);
@@ -111,6 +114,16 @@ class ComponentLabeler {
   std::vector<int16_t> pair_u_, pair_v_;
   std::vector<int16_t> px_y_, px_u_, px_v_;
   std::vector<uint8_t> px_r_, px_g_, px_b_;
+  struct RowSpan {
+    int x0 = 0, x1 = -1;  // x1 < x0: none
+  };
+  struct SweptWindow {
+    int x0, y0, y1;
+    int32_t window;      // index in the caller's windows
+    int32_t first_span;  // its row y0's span in spans_, then one per row
+  };
+  std::vector<RowSpan> spans_;
+  std::vector<SweptWindow> swept_;
   std::vector<Run> runs_;
   std::vector<int32_t> parent_;
   std::vector<int32_t> label_;

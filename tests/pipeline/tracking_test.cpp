@@ -10,6 +10,7 @@
 #include <cmath>
 #include <cstdio>
 #include <numbers>
+#include <span>
 #include <vector>
 
 #include "pipeline/components.h"
@@ -42,6 +43,29 @@ class WindowLabelTest : public ::testing::Test {
     fill(100, 60, 119, 99, {40, 160, 70});  // green 20 x 40
     fill(105, 70, 110, 75, {25, 25, 25});   // a dot inside the green
   }
+  // Sweeps `view` whole (expecting `count` components), then in `windows`,
+  // and expects the same components in the same order, none cut.
+  void expect_windows_give_the_full_sweeps_components(const ImageView& view,
+                                                      std::span<const PixelWindow> windows,
+                                                      size_t count) {
+    ASSERT_TRUE(labeler.label(view, classifier));
+    const std::vector<Component> full(labeler.components().begin(), labeler.components().end());
+    ASSERT_EQ(full.size(), count);
+    ASSERT_TRUE(labeler.label(view, classifier, windows));
+    ASSERT_EQ(labeler.components().size(), count);
+    for (size_t k = 0; k < count; ++k) {
+      const Component& c = labeler.components()[k];
+      EXPECT_EQ(c.cls, full[k].cls);
+      EXPECT_EQ(c.area_px, full[k].area_px);
+      EXPECT_EQ(c.dark_px, full[k].dark_px);
+      EXPECT_DOUBLE_EQ(c.cx, full[k].cx);
+      EXPECT_DOUBLE_EQ(c.cy, full[k].cy);
+      EXPECT_DOUBLE_EQ(c.mu20, full[k].mu20);
+      EXPECT_DOUBLE_EQ(c.mu11, full[k].mu11);
+      EXPECT_DOUBLE_EQ(c.mu02, full[k].mu02);
+      EXPECT_FALSE(c.touches_border);
+    }
+  }
   void fill(int x0, int y0, int x1, int y1, Rgb c) {
     for (int y = y0; y <= y1; ++y)
       for (int x = x0; x <= x1; ++x) test::put_rgb(&frame, x, y, c);
@@ -54,41 +78,38 @@ class WindowLabelTest : public ::testing::Test {
 };
 
 TEST_F(WindowLabelTest, WindowsAroundTheBlobsGiveTheFullSweepsComponentsExactly) {
-  ASSERT_TRUE(labeler.label(frame.view(), classifier));
-  const std::vector<Component> full(labeler.components().begin(), labeler.components().end());
-  ASSERT_EQ(full.size(), 2u);
   const PixelWindow windows[] = {{5, 5, 40, 60}, {90, 55, 130, 110}};
-  ASSERT_TRUE(labeler.label(frame.view(), classifier, windows));
-  ASSERT_EQ(labeler.components().size(), 2u);
-  for (size_t k = 0; k < 2; ++k) {
-    const Component& c = labeler.components()[k];
-    EXPECT_EQ(c.cls, full[k].cls);
-    EXPECT_EQ(c.area_px, full[k].area_px);
-    EXPECT_EQ(c.dark_px, full[k].dark_px);
-    EXPECT_DOUBLE_EQ(c.cx, full[k].cx);
-    EXPECT_DOUBLE_EQ(c.cy, full[k].cy);
-    EXPECT_DOUBLE_EQ(c.mu20, full[k].mu20);
-    EXPECT_DOUBLE_EQ(c.mu11, full[k].mu11);
-    EXPECT_FALSE(c.touches_border);
-  }
+  expect_windows_give_the_full_sweeps_components(frame.view(), windows, 2);
   EXPECT_EQ(labeler.window_cut_count(), 0);
+}
+
+// The sweep encodes each row's spans left to right whatever order the
+// windows come in: a second red blob beside the green one puts runs of
+// both windows on rows 60-99, which must join their own rows above.
+TEST_F(WindowLabelTest, WindowsInAnyOrderGiveTheFullSweepsComponentsInItsOrder) {
+  fill(10, 60, 29, 99, {200, 30, 40});
+  const PixelWindow right_first[] = {{90, 55, 130, 110}, {5, 5, 40, 105}};
+  expect_windows_give_the_full_sweeps_components(frame.view(), right_first, 3);
+}
+
+// Overlapping or touching boxes would have a row's pixels swept twice:
+// refused, as merge_windows never leaves them.
+TEST_F(WindowLabelTest, WindowsWhoseBoxesTouchAreRefused) {
+  const PixelWindow overlapping[] = {{5, 5, 40, 60}, {30, 50, 130, 110}};
+  EXPECT_FALSE(labeler.label(frame.view(), classifier, overlapping));
+  EXPECT_TRUE(labeler.components().empty());
+  const PixelWindow touching[] = {{5, 5, 40, 60}, {41, 61, 130, 110}};  // diagonally
+  EXPECT_FALSE(labeler.label(frame.view(), classifier, touching));
+  const PixelWindow apart[] = {{5, 5, 40, 60}, {42, 61, 130, 110}};
+  EXPECT_TRUE(labeler.label(frame.view(), classifier, apart));
 }
 
 // YUYV pairs share their chroma: windows starting and ending on odd columns
 // must classify as the whole-frame sweep does.
 TEST_F(WindowLabelTest, YuyvWindowsOnOddColumnsMatchTheFullSweep) {
   const Image yuyv = test::convert_rgb(frame, PixelFormat::kYuyv);
-  ASSERT_TRUE(labeler.label(yuyv.view(), classifier));
-  const std::vector<Component> full(labeler.components().begin(), labeler.components().end());
-  ASSERT_EQ(full.size(), 2u);
   const PixelWindow windows[] = {{5, 5, 41, 60}, {91, 55, 131, 110}};
-  ASSERT_TRUE(labeler.label(yuyv.view(), classifier, windows));
-  ASSERT_EQ(labeler.components().size(), 2u);
-  for (size_t k = 0; k < 2; ++k) {
-    EXPECT_EQ(labeler.components()[k].area_px, full[k].area_px);
-    EXPECT_DOUBLE_EQ(labeler.components()[k].cx, full[k].cx);
-    EXPECT_DOUBLE_EQ(labeler.components()[k].cy, full[k].cy);
-  }
+  expect_windows_give_the_full_sweeps_components(yuyv.view(), windows, 2);
 }
 
 // A window shaped to a marker seen at an angle: only its inside is swept,
