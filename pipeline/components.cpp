@@ -438,8 +438,8 @@ void ComponentLabeler::plan_spans(const ImageView& frame, std::span<const PixelW
   // the windows' pixels cost a tracked 640x480 RGB frame ~60 us less
   // (docs/pipeline_speed.md). A whole sweep reads in address order and
   // needs no help.
-  const bool ask = prefetch && frame.width == width_ && frame.height == height_ &&
-                   !frame.empty() && frame.format != PixelFormat::kGray8;
+  const bool ask = prefetch && frame.width == width_ && frame.height == height_ && !frame.empty() &&
+                   frame.format != PixelFormat::kGray8;
   int32_t first = 0;
   for (SweptWindow& sw : swept_) {
     const PixelWindow& w = windows[static_cast<size_t>(sw.window)];
