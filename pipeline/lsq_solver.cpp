@@ -44,12 +44,7 @@ bool LsqSolver::solve(const ViewGeometry& view, const PositioningParams& params,
   const std::span<const bool> kept(fit.use.data(), use.size());
 
   // 3. Accept only a solution that explains the points.
-  LsqNormal a{};
-  LsqVector b{};
-  double wr2 = 0.0;
-  int n = 0;
-  accumulate(view, params, points(), kept, fit.state, fit.model, true, &a, &b, &wr2, &n);
-  prior_cost(view, params, fit.model, fit.state, &a, &b);
+  const int n = fit.residuals;
   if (n < 2 * params.lsq_min_points) return false;  // two residuals a point
   const double rms = rms_px(view, kept, fit.state, n);
   if (!(rms <= params.lsq_max_rms_px)) return false;
@@ -58,7 +53,7 @@ bool LsqSolver::solve(const ViewGeometry& view, const PositioningParams& params,
   out->robot =
       view.robot_from_camera(fit.state.t_w[0], fit.state.t_w[1], camera_yaw_of(fit.state.r_wc));
   if (!covariance_.robot_covariance(view, params, fit.model, points(), fixes, use, kept, fit.state,
-                                    a, wr2, n, out->robot, &out->covariance))
+                                    fit.a, fit.wr2, n, out->robot, &out->covariance))
     return false;
   out->rms_px = rms;
   out->markers = fit.markers;
@@ -202,22 +197,14 @@ LsqSolver::Fit LsqSolver::choose_tilt_model(const ViewGeometry& view,
   // the tilt out would cost: how far the free pose is from the held one, in
   // units of the free pose's own standard deviation (its normal equations
   // cost a pass over the points: level views, the common case, skip it).
-  LsqNormal a{};
-  LsqVector b{};
-  double wr2 = 0.0;
-  int n = 0;
-  const std::span<const bool> free_use(free.use.data(), fixes.size());
-  accumulate(view, params, points(), free_use, free.state, free.model, false, &a, &b, &wr2, &n);
-  const double sigma2 = free.cost / std::max(1, n - free.model.free_count());
+  const double sigma2 = free.cost / std::max(1, free.residuals - free.model.free_count());
   out->tilt_chi2 = sigma2 > 0.0 ? (held.cost - free.cost) / sigma2 : 0.0;
   out->tilt_shift_m =
       std::hypot(free.state.t_w[0] - held.state.t_w[0], free.state.t_w[1] - held.state.t_w[1]);
   const bool better = out->tilt_chi2 > params.lsq_tilt_select_chi2;
   bool matters = false;
   if (better) {
-    accumulate(view, params, points(), free_use, free.state, free.model, true, &a, &b, &wr2, &n);
-    prior_cost(view, params, free.model, free.state, &a, &b);
-    out->tilt_free_sigma_m = position_sigma_m(free.model, a, wr2, n);
+    out->tilt_free_sigma_m = position_sigma_m(free.model, free.a, free.wr2, free.residuals);
     matters = out->tilt_shift_m > params.lsq_tilt_select_shift_sigmas * out->tilt_free_sigma_m;
   }
   out->tilt_choice = better && matters ? TiltChoice::kFreeFits : TiltChoice::kHeldFits;
@@ -278,6 +265,8 @@ void LsqSolver::optimise(const ViewGeometry& view, const PositioningParams& para
         cost = trial_cost;
         a = ta;
         b = tb;
+        wr2 = twr2;
+        n = tn;
         lambda = std::max(lambda * 0.1, 1e-9);
         double step_norm = 0.0;
         for (double v : step) step_norm = std::max(step_norm, std::abs(v));
@@ -288,6 +277,10 @@ void LsqSolver::optimise(const ViewGeometry& view, const PositioningParams& para
       }
     }
     fit->cost = cost;
+    fit->a = a;
+    fit->b = b;
+    fit->wr2 = wr2;
+    fit->residuals = n;
     if (fit->markers <= 1 || pass == params.lsq_max_rejections) break;
     const int worst = worst_marker(view, params, fixes, *fit);
     if (worst < 0) break;
