@@ -195,8 +195,8 @@ LsqSolver::Fit LsqSolver::choose_tilt_model(const ViewGeometry& view,
   // The evidence: how much better the free model explains the points, in
   // units of its own noise; and, only when that is significant, what leaving
   // the tilt out would cost: how far the free pose is from the held one, in
-  // units of the free pose's own standard deviation (its normal equations
-  // cost a pass over the points: level views, the common case, skip it).
+  // units of the free pose's own standard deviation (from the free fit's
+  // normal matrix: level views, the common case, skip it).
   const double sigma2 = free.cost / std::max(1, free.residuals - free.model.free_count());
   out->tilt_chi2 = sigma2 > 0.0 ? (held.cost - free.cost) / sigma2 : 0.0;
   out->tilt_shift_m =
@@ -278,7 +278,6 @@ void LsqSolver::optimise(const ViewGeometry& view, const PositioningParams& para
     }
     fit->cost = cost;
     fit->a = a;
-    fit->b = b;
     fit->wr2 = wr2;
     fit->residuals = n;
     if (fit->markers <= 1 || pass == params.lsq_max_rejections) break;

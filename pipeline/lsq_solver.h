@@ -84,12 +84,11 @@ class LsqSolver {
     std::array<bool, kMaxMarkersPerFrame> use{};
     int markers = 0;
     double cost = INFINITY;  // not finite: no solution
-    // What optimise ended with: the normal equations (priors included) at
+    // What optimise ended with: the normal matrix (priors included) at
     // `state` over the markers in `use`, and the Huber-weighted squared
     // residuals over their count. Valid while cost is finite and the fit is
     // not changed after optimise.
     LsqNormal a{};
-    LsqVector b{};
     double wr2 = 0.0;
     int residuals = 0;
   };
