@@ -9,8 +9,23 @@
 
 namespace ceilpose::fuzz {
 
+namespace {
+
+std::string scratch_path() { return "/dev/shm/ceilpose-fuzz-" + std::to_string(::getpid()); }
+
+// At exit: /dev/shm is memory, and every fuzz run used to leave its directory.
+void remove_scratch() {
+  std::error_code ec;
+  std::filesystem::remove_all(scratch_path(), ec);
+}
+
+}  // namespace
+
 const std::string& scratch_dir() {
-  static const std::string dir = "/dev/shm/ceilpose-fuzz-" + std::to_string(::getpid());
+  static const std::string dir = [] {
+    std::atexit(remove_scratch);
+    return scratch_path();
+  }();
   std::error_code ec;
   std::filesystem::remove_all(dir, ec);
   std::filesystem::create_directories(dir, ec);

@@ -25,7 +25,7 @@ constexpr int kBoundMs = 15000;
 
 class DaemonHostile : public ::testing::Test {
  protected:
-  void TearDown() override { (void)ShmPoseWriter::remove(shm_); }
+  void TearDown() override { remove_daemon_segments(shm_); }
   std::vector<std::string> args(std::vector<std::string> extra) const {
     std::vector<std::string> a{"--shm", shm_, "--no-dds"};
     a.insert(a.end(), extra.begin(), extra.end());

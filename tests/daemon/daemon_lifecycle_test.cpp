@@ -46,7 +46,7 @@ std::string config_text(int min_rect_area_px = 150) {
 
 class DaemonLifecycle : public ::testing::Test {
  protected:
-  void TearDown() override { (void)ShmPoseWriter::remove(shm_); }
+  void TearDown() override { remove_daemon_segments(shm_); }
 
   std::unique_ptr<DaemonProcess> start(const std::vector<std::string>& extra = {},
                                        std::map<std::string, std::string> env = {}) {
@@ -607,7 +607,7 @@ TEST_F(DaemonLifecycle, TwoDaemonsWithOneRobotNameOnDdsEachWarn) {
       << first.err();
   first.signal(SIGTERM);
   ASSERT_TRUE(first.wait(5000).has_value()) << first.err();
-  (void)ShmPoseWriter::remove(other_shm);
+  remove_daemon_segments(other_shm);
 }
 
 TEST_F(DaemonLifecycle, DurationEndsTheRunWithExitZero) {

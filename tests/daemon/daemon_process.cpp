@@ -16,6 +16,9 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "ipc/shm/shm_fleet_writer.h"
+#include "ipc/shm/shm_pose_writer.h"
+
 namespace ceilpose::test {
 namespace {
 
@@ -115,6 +118,11 @@ std::string unique_shm_name() {
 bool shm_exists(const std::string& name) {
   struct stat st {};
   return stat(("/dev/shm" + name).c_str(), &st) == 0;
+}
+
+void remove_daemon_segments(const std::string& shm) {
+  (void)ShmPoseWriter::remove(shm);
+  (void)ShmFleetWriter::remove(fleet_segment_name(shm));
 }
 
 std::string write_temp_file(const std::string& stem, const std::string& text) {

@@ -57,6 +57,9 @@ RunResult run_daemon(const std::vector<std::string>& args, int timeout_ms = 2000
 // A name unique to this test process and call, e.g. "/ceilpose-test-1234-3".
 std::string unique_shm_name();
 bool shm_exists(const std::string& name);
+// Unlinks what a daemon leaves under `shm` (its pose, wake and fleet
+// segments stay after a clean stop, docs/ipc.md): every test's clean-up.
+void remove_daemon_segments(const std::string& shm);
 // Writes `text` to a fresh file under the test temp dir and returns its path.
 std::string write_temp_file(const std::string& stem, const std::string& text);
 

@@ -58,7 +58,7 @@ TEST(DaemonReplay, LocalizesWithTheRecordingsCameraNotTheConfiguredOne) {
   // The default configuration describes a 640x480 camera.
   auto r = run_daemon({"--source", "replay:" + dir, "--shm", shm, "--no-dds", "--print-poses",
                        "--duration", "2.5"});
-  (void)ShmPoseWriter::remove(shm);
+  remove_daemon_segments(shm);
   std::filesystem::remove_all(dir);
   ASSERT_EQ(r.exit.code, ceilpose::kExitOk) << r.err;
   EXPECT_NE(r.err.find("camera model from the recording: 320x240"), std::string::npos) << r.err;
@@ -86,7 +86,7 @@ TEST(DaemonReplay, NoFrameForLongerThanStaleAfterMsIsALostFix) {
   ASSERT_TRUE(reader) << reader.error().message;
   StatusRecord status{};
   ASSERT_EQ(reader->read_status(&status), ReadResult::kOk);
-  (void)ShmPoseWriter::remove(shm);
+  remove_daemon_segments(shm);
   EXPECT_EQ(status.frames, 10u);
   EXPECT_EQ(static_cast<FixState>(status.fix_state), FixState::kLost)
       << to_string(static_cast<FixState>(status.fix_state));
@@ -104,7 +104,7 @@ TEST(DaemonReplay, HeightsTheMarkersContradictGiveNoPoseAndAReasonInTheLog) {
   }
   auto r = run_daemon({"--config", config, "--source", "replay:" + dir, "--shm", shm, "--no-dds",
                        "--print-poses", "--duration", "2.5"});
-  (void)ShmPoseWriter::remove(shm);
+  remove_daemon_segments(shm);
   std::filesystem::remove_all(dir);
   std::filesystem::remove(config);
   ASSERT_EQ(r.exit.code, ceilpose::kExitOk) << r.err;

@@ -35,7 +35,7 @@ class DaemonSecurity : public ::testing::Test {
  protected:
   // ceilposectl fleet, run from here, is on loopback as the daemon is.
   void SetUp() override { use_loopback_dds(); }
-  void TearDown() override { (void)ShmPoseWriter::remove(shm_); }
+  void TearDown() override { remove_daemon_segments(shm_); }
 
   std::vector<std::string> args(const std::string& keystore, const std::string& robot,
                                 std::vector<std::string> extra = {}) const {
@@ -166,7 +166,7 @@ TEST_F(DaemonSecurity, OnlyAuthenticatedRobotsAppearInTheFleet) {
   EXPECT_TRUE(names_in(*fleet_c).empty()) << "a robot without a certificate sees nobody";
   for (DaemonProcess* d : {&a, &b, &c}) d->signal(SIGTERM);
   for (DaemonProcess* d : {&a, &b, &c}) EXPECT_TRUE(d->wait(10'000).has_value());
-  for (const std::string& s : {shm_b, shm_c}) (void)ShmPoseWriter::remove(s);
+  for (const std::string& s : {shm_b, shm_c}) remove_daemon_segments(s);
   for (const std::string& s : {shm_, shm_b, shm_c})
     (void)ShmFleetWriter::remove(fleet_segment_name(s));
 }

@@ -187,9 +187,11 @@ bool dies_of_sigbus(int status) {
 }
 
 TEST(ShmSigbusGuard, AFaultOutsideEverySegmentStillKills) {
+  // Named here, not in the child: the child dies of its fault, and this
+  // process's clean-up unlinks what it created.
+  test::ScopedSegmentName other;
   EXPECT_EXIT(
       {
-        test::ScopedSegmentName other;
         ShmOptions options;
         options.name = other.str();
         auto writer = ShmPoseWriter::create(options);  // installs the handler
