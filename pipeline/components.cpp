@@ -435,7 +435,7 @@ void ComponentLabeler::plan_spans(const ImageView& frame, std::span<const PixelW
   // A camera's frame arrives in memory, not in cache, and a window's span
   // (a few hundred bytes a row, a dozen places a row) is too short a stream
   // for the hardware prefetcher: asked for all at once, before the sweep,
-  // the windows' pixels cost a tracked 640x480 RGB frame ~60 us less
+  // the windows' pixels cost a tracked 640x480 RGB frame 60-85 us less
   // (docs/pipeline_speed.md). A whole sweep reads in address order and
   // needs no help.
   const bool ask = prefetch && frame.width == width_ && frame.height == height_ && !frame.empty() &&
