@@ -13,24 +13,6 @@ bool CameraIntrinsics::has_distortion() const {
   return false;
 }
 
-Mat3 mat_mul(const Mat3& a, const Mat3& b) {
-  Mat3 c{};
-  for (int r = 0; r < 3; ++r)
-    for (int col = 0; col < 3; ++col) {
-      double s = 0.0;
-      for (int k = 0; k < 3; ++k) s += a[r * 3 + k] * b[k * 3 + col];
-      c[r * 3 + col] = s;
-    }
-  return c;
-}
-
-Mat3 mat_transpose(const Mat3& a) { return {a[0], a[3], a[6], a[1], a[4], a[7], a[2], a[5], a[8]}; }
-
-Vec3 mat_vec(const Mat3& a, const Vec3& v) {
-  return {a[0] * v[0] + a[1] * v[1] + a[2] * v[2], a[3] * v[0] + a[4] * v[1] + a[5] * v[2],
-          a[6] * v[0] + a[7] * v[1] + a[8] * v[2]};
-}
-
 Mat3 tilt_rotation(double tilt_x_rad, double tilt_y_rad) {
   const double ca = std::cos(tilt_x_rad), sa = std::sin(tilt_x_rad);
   const double cb = std::cos(tilt_y_rad), sb = std::sin(tilt_y_rad);
