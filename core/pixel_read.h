@@ -10,18 +10,38 @@
 #include <atomic>
 #include <cstddef>
 #include <cstdint>
+#include <type_traits>
 
 #include "core/image.h"
 
 namespace ceilpose {
 
-// BT.601 limited range (V4L2's default quantisation for YUYV) to RGB, integer.
-inline void yuv_to_rgb(int y, int u, int v, uint8_t* r, uint8_t* g, uint8_t* b) {
-  const int c = 298 * (y - 16) + 128;
+// BT.601 limited range (V4L2's default quantisation for YUYV) to RGB,
+// integer: channel = clamp((luma part + the channel's chroma part) >> 8).
+inline int yuv_luma_part(int y) { return 298 * (y - 16) + 128; }
+struct YuvChromaParts {
+  int r, g, b;
+};
+inline YuvChromaParts yuv_chroma_parts(int u, int v) {
   const int d = u - 128, e = v - 128;
-  *r = static_cast<uint8_t>(std::clamp((c + 409 * e) >> 8, 0, 255));
-  *g = static_cast<uint8_t>(std::clamp((c - 100 * d - 208 * e) >> 8, 0, 255));
-  *b = static_cast<uint8_t>(std::clamp((c + 516 * d) >> 8, 0, 255));
+  return {409 * e, -100 * d - 208 * e, 516 * d};
+}
+inline uint8_t yuv_channel(int luma_part, int chroma_part) {
+  return static_cast<uint8_t>(std::clamp((luma_part + chroma_part) >> 8, 0, 255));
+}
+inline void yuv_to_rgb(int y, int u, int v, uint8_t* r, uint8_t* g, uint8_t* b) {
+  const int c = yuv_luma_part(y);
+  const YuvChromaParts p = yuv_chroma_parts(u, v);
+  *r = yuv_channel(c, p.r);
+  *g = yuv_channel(c, p.g);
+  *b = yuv_channel(c, p.b);
+}
+// The darkest of the three channels yuv_to_rgb gives, without the three: a
+// channel rises with its chroma part (clamp and shift keep order), so the
+// darkest is the one with the least.
+inline uint8_t yuv_darkest(int y, int u, int v) {
+  const YuvChromaParts p = yuv_chroma_parts(u, v);
+  return yuv_channel(yuv_luma_part(y), std::min({p.r, p.g, p.b}));
 }
 
 // RGB of pixel (x, y) of a frame in format F (not MJPEG); grey gives
@@ -48,33 +68,58 @@ inline Rgb pixel_rgb(const ImageView& f, int x, int y) {
   return c;
 }
 
-// Calls fn(pixel_rgb<F>) for the frame's format F; false for MJPEG (no
-// pixels to read).
+// The darkest channel of pixel_rgb<F>(f, x, y), as std::min of its three.
+template <PixelFormat F>
+inline uint8_t pixel_darkest(const ImageView& f, int x, int y) {
+  const uint8_t* p = f.row(y);
+  if constexpr (F == PixelFormat::kYuyv) {
+    const uint8_t* q = p + 4 * (x / 2);
+    return yuv_darkest(q[(x & 1) * 2], q[1], q[3]);
+  } else if constexpr (F == PixelFormat::kNv12) {
+    const uint8_t* uv = f.uv_row(y) + (x & ~1);
+    return yuv_darkest(p[x], uv[0], uv[1]);
+  } else if constexpr (F == PixelFormat::kYuv420) {
+    return yuv_darkest(p[x], f.u_row(y)[x / 2], f.v_row(y)[x / 2]);
+  } else {
+    const Rgb c = pixel_rgb<F>(f, x, y);
+    return std::min({c.r, c.g, c.b});
+  }
+}
+
+// Calls fn(std::integral_constant<PixelFormat, F>) for the frame's format F;
+// false for MJPEG (no pixels to read). One dispatch for a caller's many
+// reads.
 template <typename Fn>
-inline bool with_pixel_reader(PixelFormat format, Fn&& fn) {
+inline bool with_pixel_format(PixelFormat format, Fn&& fn) {
   switch (format) {
     case PixelFormat::kRgb24:
-      fn(pixel_rgb<PixelFormat::kRgb24>);
+      fn(std::integral_constant<PixelFormat, PixelFormat::kRgb24>{});
       return true;
     case PixelFormat::kBgr24:
-      fn(pixel_rgb<PixelFormat::kBgr24>);
+      fn(std::integral_constant<PixelFormat, PixelFormat::kBgr24>{});
       return true;
     case PixelFormat::kYuyv:
-      fn(pixel_rgb<PixelFormat::kYuyv>);
+      fn(std::integral_constant<PixelFormat, PixelFormat::kYuyv>{});
       return true;
     case PixelFormat::kNv12:
-      fn(pixel_rgb<PixelFormat::kNv12>);
+      fn(std::integral_constant<PixelFormat, PixelFormat::kNv12>{});
       return true;
     case PixelFormat::kYuv420:
-      fn(pixel_rgb<PixelFormat::kYuv420>);
+      fn(std::integral_constant<PixelFormat, PixelFormat::kYuv420>{});
       return true;
     case PixelFormat::kGray8:
-      fn(pixel_rgb<PixelFormat::kGray8>);
+      fn(std::integral_constant<PixelFormat, PixelFormat::kGray8>{});
       return true;
     case PixelFormat::kMjpeg:
       break;
   }
   return false;
+}
+
+// Calls fn(pixel_rgb<F>) for the frame's format F; false for MJPEG.
+template <typename Fn>
+inline bool with_pixel_reader(PixelFormat format, Fn&& fn) {
+  return with_pixel_format(format, [&](auto tag) { fn(pixel_rgb<decltype(tag)::value>); });
 }
 
 // RGB of pixel (x, y) in any uncompressed format; grey gives r = g = b.
@@ -93,6 +138,15 @@ inline void read_rgb_2x2(const ImageView& f, int x, int y, std::array<Rgb, 4>* o
   out->fill(Rgb{0, 0, 0});
   with_pixel_reader(f.format, [&](auto read) {
     for (int k = 0; k < 4; ++k) (*out)[k] = read(f, x + (k & 1), y + (k >> 1));
+  });
+}
+
+// The same four pixels' darkest channels (pixel_darkest); 0 for MJPEG.
+inline void read_darkest_2x2(const ImageView& f, int x, int y, std::array<uint8_t, 4>* out) {
+  out->fill(0);
+  with_pixel_format(f.format, [&](auto tag) {
+    for (int k = 0; k < 4; ++k)
+      (*out)[k] = pixel_darkest<decltype(tag)::value>(f, x + (k & 1), y + (k >> 1));
   });
 }
 

@@ -33,10 +33,8 @@ double darkest_at(const ImageView& frame, double u, double v) {
   const int x0 = static_cast<int>(std::floor(u)), y0 = static_cast<int>(std::floor(v));
   if (x0 < 0 || y0 < 0 || x0 + 1 >= frame.width || y0 + 1 >= frame.height) return -1.0;
   const double fu = u - x0, fv = v - y0;
-  std::array<Rgb, 4> px;
-  read_rgb_2x2(frame, x0, y0, &px);
-  double corner[4];
-  for (int c = 0; c < 4; ++c) corner[c] = std::min({px[c].r, px[c].g, px[c].b});
+  std::array<uint8_t, 4> corner;
+  read_darkest_2x2(frame, x0, y0, &corner);
   return (1 - fv) * ((1 - fu) * corner[0] + fu * corner[1]) +
          fv * ((1 - fu) * corner[2] + fu * corner[3]);
 }
@@ -54,7 +52,7 @@ struct Crossings {
 bool profile(const ImageView& frame, const MarkerFrame& marker, double e_m, double n_m, double de,
              double dn, int samples, Crossings* out) {
   const double step_m = 2.0 * kProfileHalf_m / (samples - 1);
-  std::array<double, kMaxSamples> level{};
+  std::array<double, kMaxSamples> level;  // samples of them written before any is read
   for (int k = 0; k < samples; ++k) {
     const double s_m = -kProfileHalf_m + k * step_m;
     double u = 0.0, v = 0.0;

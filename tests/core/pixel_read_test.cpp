@@ -1,17 +1,23 @@
-// read_rgb_2x2, the bilinear samples' reader (dot slots, rectangle edges),
-// gives each of its four pixels exactly as read_rgb does, in every format:
-// random bytes, every position, odd and even columns and rows.
+// read_rgb_2x2 and read_darkest_2x2, the bilinear samples' readers (dot
+// slots, rectangle edges), give each of their four pixels exactly as read_rgb
+// does, in every format: random bytes, every position, odd and even columns
+// and rows.
 #include "core/pixel_read.h"
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <random>
+#include <string>
 
 namespace ceilpose {
 namespace {
 
-TEST(PixelRead, TwoByTwoBlocksAreReadRgbOfTheirFourPixelsInEveryFormat) {
-  std::mt19937 rng(7);
+// Calls check(view, x, y, message) for every 2x2 block's top-left pixel of a
+// 10x6 image of random bytes in every uncompressed format.
+template <typename Check>
+void for_every_block(uint32_t seed, Check&& check) {
+  std::mt19937 rng(seed);
   std::uniform_int_distribution<int> byte(0, 255);
   for (PixelFormat format : {PixelFormat::kRgb24, PixelFormat::kBgr24, PixelFormat::kYuyv,
                              PixelFormat::kNv12, PixelFormat::kYuv420, PixelFormat::kGray8}) {
@@ -19,20 +25,52 @@ TEST(PixelRead, TwoByTwoBlocksAreReadRgbOfTheirFourPixelsInEveryFormat) {
     for (size_t i = 0; i < image.size_bytes(); ++i)
       image.data()[i] = static_cast<uint8_t>(byte(rng));
     const ImageView view = image.view();
-    for (int y = 0; y + 1 < view.height; ++y) {
-      for (int x = 0; x + 1 < view.width; ++x) {
-        std::array<Rgb, 4> block;
-        read_rgb_2x2(view, x, y, &block);
-        for (int k = 0; k < 4; ++k) {
-          uint8_t r = 0, g = 0, b = 0;
-          read_rgb(view, x + (k & 1), y + (k >> 1), &r, &g, &b);
-          EXPECT_EQ(block[k].r, r) << static_cast<int>(format) << " " << x << "," << y << " " << k;
-          EXPECT_EQ(block[k].g, g) << static_cast<int>(format) << " " << x << "," << y << " " << k;
-          EXPECT_EQ(block[k].b, b) << static_cast<int>(format) << " " << x << "," << y << " " << k;
-        }
-      }
-    }
+    for (int y = 0; y + 1 < view.height; ++y)
+      for (int x = 0; x + 1 < view.width; ++x)
+        check(view, x, y,
+              "format " + std::to_string(static_cast<int>(format)) + " at " + std::to_string(x) +
+                  "," + std::to_string(y));
   }
+}
+
+TEST(PixelRead, TwoByTwoBlocksAreReadRgbOfTheirFourPixelsInEveryFormat) {
+  for_every_block(7, [](const ImageView& view, int x, int y, const std::string& where) {
+    std::array<Rgb, 4> block;
+    read_rgb_2x2(view, x, y, &block);
+    for (int k = 0; k < 4; ++k) {
+      uint8_t r = 0, g = 0, b = 0;
+      read_rgb(view, x + (k & 1), y + (k >> 1), &r, &g, &b);
+      EXPECT_EQ(block[k].r, r) << where << " pixel " << k;
+      EXPECT_EQ(block[k].g, g) << where << " pixel " << k;
+      EXPECT_EQ(block[k].b, b) << where << " pixel " << k;
+    }
+  });
+}
+
+// yuv_darkest takes the least chroma part instead of converting: the same
+// byte as the least of yuv_to_rgb's three for every (y, u, v).
+TEST(PixelRead, YuvDarkestIsTheLeastOfTheThreeChannelsForEveryYuv) {
+  int mismatches = 0;
+  for (int y = 0; y < 256; ++y)
+    for (int u = 0; u < 256; ++u)
+      for (int v = 0; v < 256; ++v) {
+        uint8_t r = 0, g = 0, b = 0;
+        yuv_to_rgb(y, u, v, &r, &g, &b);
+        mismatches += yuv_darkest(y, u, v) != std::min({r, g, b}) ? 1 : 0;
+      }
+  EXPECT_EQ(mismatches, 0);
+}
+
+TEST(PixelRead, TwoByTwoDarkestIsTheLeastChannelOfReadRgbInEveryFormat) {
+  for_every_block(11, [](const ImageView& view, int x, int y, const std::string& where) {
+    std::array<uint8_t, 4> block;
+    read_darkest_2x2(view, x, y, &block);
+    for (int k = 0; k < 4; ++k) {
+      uint8_t r = 0, g = 0, b = 0;
+      read_rgb(view, x + (k & 1), y + (k >> 1), &r, &g, &b);
+      EXPECT_EQ(block[k], std::min({r, g, b})) << where << " pixel " << k;
+    }
+  });
 }
 
 }  // namespace
