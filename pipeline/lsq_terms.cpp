@@ -90,7 +90,7 @@ bool point_residual(const ViewGeometry& view, const LsqPoint& pt, const PointCam
 // A point exposed tau after the centre row has its camera at t + v·tau and
 // Exp(w·tau·z)·R, so v and w move it as t and the yaw do, tau times as much.
 void point_jacobian(const ViewGeometry& view, const LsqPoint& pt, const PointCamera& cam,
-                    double* jx, double* jy) {
+                    double* jx, double* jy, bool with_tilt) {
   const double fx = view.intrinsics().fx, fy = view.intrinsics().fy;
   const Vec3& d = cam.d;
   const Vec3 p = mat_vec(cam.rt, d);
@@ -102,7 +102,7 @@ void point_jacobian(const ViewGeometry& view, const LsqPoint& pt, const PointCam
     dp[row][kLsqTz] = -cam.rt[row * 3 + 2];
   }
   const int rot_cols[3] = {kLsqYaw, kLsqTiltX, kLsqTiltY};
-  for (int c = 0; c < 3; ++c) {
+  for (int c = 0; c < (with_tilt ? 3 : 1); ++c) {
     const Vec3& w3 = cam.axis[c];
     const Vec3 cross{d[1] * w3[2] - d[2] * w3[1], d[2] * w3[0] - d[0] * w3[2],
                      d[0] * w3[1] - d[1] * w3[0]};  // [d]×·w = d × w
@@ -168,7 +168,7 @@ double accumulate(const ViewGeometry& view, const PositioningParams& params,
     n += pt.residuals();
     if (!with_jacobian) continue;
     double jx[kN], jy[kN];
-    point_jacobian(view, pt, cam, jx, jy);
+    point_jacobian(view, pt, cam, jx, jy, model.tilt_free());
     for (int i = 0; i < free_n; ++i) {
       const int r1 = free[i];
       (*b)[r1] -= w * (jx[r1] * rx + jy[r1] * ry);
