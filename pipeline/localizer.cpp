@@ -60,7 +60,12 @@ const Localization& Localizer::localize(const ImageView& image, const FrameInfo&
   FullSweepReason sweep = plan_sweep();
   out_.swept_px = 0;
   if (sweep == FullSweepReason::kNone) {
-    pipeline_.process(image, config.positioning.mode, result_.get(), motion, plan_.span());
+    if (config.detector.track_edges) {
+      pipeline_.process_tracked(image, config.positioning.mode, result_.get(), motion,
+                                plan_.predicted_span());
+    } else {
+      pipeline_.process(image, config.positioning.mode, result_.get(), motion, plan_.span());
+    }
     out_.swept_px = result_->swept_px;
     if (!tracked_sweep_held()) sweep = FullSweepReason::kTrackFailed;
   }

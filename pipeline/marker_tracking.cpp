@@ -42,6 +42,39 @@ double PredictionErrors::max_yaw_rad() const {
   return *std::max_element(yaw_rad_.begin(), yaw_rad_.end());
 }
 
+namespace {
+
+// The affine view of marker `p`'s frame (pixels per metre East and North at
+// its centre, over 1 cm) seen from the robot's pose `s` advanced by tau_s
+// of its motion; false when a point does not project.
+bool marker_frame_at(const ViewGeometry& view, const MarkerPlacement& p, const MotionState& s,
+                     double tau_s, MarkerFrame* out) {
+  constexpr double kStep_m = 0.01;
+  const Pose2D robot{s.x[0] + s.x[3] * tau_s, s.x[1] + s.x[4] * tau_s, s.x[2] + s.x[5] * tau_s};
+  const CameraPose camera = camera_pose_from_robot(robot, view.mount());
+  const double points_m[3][2] = {{0.0, 0.0}, {kStep_m, 0.0}, {0.0, kStep_m}};
+  double u[3], v[3];
+  for (int q = 0; q < 3; ++q) {
+    double x_m = 0.0, y_m = 0.0;
+    p.world_point(points_m[q][0], points_m[q][1], &x_m, &y_m);
+    if (!project_world_point(view.intrinsics(), camera, {x_m, y_m, view.layout().height_m}, &u[q],
+                             &v[q]))
+      return false;
+  }
+  out->centre_u_px = u[0];
+  out->centre_v_px = v[0];
+  out->east_u = (u[1] - u[0]) / kStep_m;
+  out->east_v = (v[1] - v[0]) / kStep_m;
+  out->north_u = (u[2] - u[0]) / kStep_m;
+  out->north_v = (v[2] - v[0]) / kStep_m;
+  // West is image direction −East.
+  out->west_image_rad = std::atan2(-out->east_v, -out->east_u);
+  return std::isfinite(out->centre_u_px + out->centre_v_px + out->east_u + out->east_v +
+                       out->north_u + out->north_v);
+}
+
+}  // namespace
+
 FullSweepReason plan_tracking(const ViewGeometry& view, const DetectorParams& params,
                               const MotionState& s, const PredictionErrors& errors,
                               TrackingPlan* plan) {
@@ -152,6 +185,15 @@ FullSweepReason plan_tracking(const ViewGeometry& view, const DetectorParams& pa
       // Whole beyond doubt: inside the frame even if the prediction is off
       // by the whole margin.
       if (x0 >= 0.0 && y0 >= 0.0 && x1 <= w && y1 <= h) {
+        // Its frame where its centre row is exposed (the prediction is the
+        // centre row's): two passes find the row.
+        PredictedMarker& pm = plan->predicted[static_cast<size_t>(plan->expected_whole)];
+        pm.code_i = i;
+        pm.code_j = j;
+        bool framed = marker_frame_at(view, *p, s, 0.0, &pm.frame);
+        if (framed && k.readout_ms > 0.0)
+          framed = marker_frame_at(view, *p, s, row_time_s(k, pm.frame.centre_v_px), &pm.frame);
+        if (!framed) return FullSweepReason::kUncertain;
         plan->whole[plan->expected_whole++] = j * codes + i;
       }
     }

@@ -20,9 +20,19 @@
 #include "core/view_geometry.h"
 #include "pipeline/components.h"
 #include "pipeline/detector_params.h"
+#include "pipeline/dot_reader.h"
 #include "pipeline/marker_observation.h"
 
 namespace ceilpose {
+
+// A marker the prediction puts wholly in the frame: its codes and the
+// affine view of its frame there (at its own row's instant under a rolling
+// shutter), where an edge-tracked frame measures its edges and reads its
+// dots (detector.track_edges).
+struct PredictedMarker {
+  int code_i = 0, code_j = 0;
+  MarkerFrame frame;
+};
 
 struct TrackingPlan {
   std::array<PixelWindow, kMaxMarkersPerFrame> windows{};
@@ -32,6 +42,11 @@ struct TrackingPlan {
   // sweep does not was not where its window looked.
   std::array<int32_t, kMaxMarkersPerFrame> whole{};
   int expected_whole = 0;
+  // The same markers, where they will be (whole[k] is predicted[k]'s).
+  std::array<PredictedMarker, kMaxMarkersPerFrame> predicted{};
+  std::span<const PredictedMarker> predicted_span() const {
+    return {predicted.data(), static_cast<size_t>(expected_whole)};
+  }
   double margin_px = 0.0;
   std::span<const PixelWindow> span() const {
     return {windows.data(), static_cast<size_t>(window_count)};

@@ -12,11 +12,14 @@
 #include "core/image.h"
 #include "pipeline/color_classifier.h"
 #include "pipeline/components.h"
+#include "pipeline/dot_reader.h"
 #include "pipeline/marker_observation.h"
 #include "pipeline/marker_pairing.h"
+#include "pipeline/marker_tracking.h"
 #include "pipeline/pipeline_config.h"
 #include "pipeline/pose_estimate.h"
 #include "pipeline/positioner.h"
+#include "pipeline/rectangle_ends.h"
 #include "pipeline/rectangle_fit.h"
 
 namespace ceilpose {
@@ -99,6 +102,13 @@ class Pipeline {
   void process(const ImageView& frame, PositioningMode mode, FrameResult* out,
                const CameraMotion& motion = {}, std::span<const PixelWindow> windows = {});
 
+  // A tracked frame measured where the prediction puts each marker (plan_tracking's
+  // predicted markers, detector.track_edges): its edges and dots only, no
+  // classification, no components (pairs() then stays empty). A marker
+  // whose codes read otherwise than predicted is rejected as inconsistent.
+  void process_tracked(const ImageView& frame, PositioningMode mode, FrameResult* out,
+                       const CameraMotion& motion, std::span<const PredictedMarker> predicted);
+
   // Replaces the configuration (SIGHUP reload of thresholds); rebuilds the
   // colour table and re-allocates only if the image size changed. Not in the
   // per-frame path.
@@ -116,7 +126,16 @@ class Pipeline {
 
  private:
   bool usable(const ImageView& frame) const;
+  class StageClock;
+  Refusal begin(const ImageView& frame, FrameResult* out);
+  void position(PositioningMode mode, const CameraMotion& motion, FrameResult* out,
+                StageClock* clock);
+  PairOutcome read_codes(const ImageView& frame, const MarkerFrame& m,
+                         const RectangleEdges& red_edges, CodeReading* code_i,
+                         CodeReading* code_j) const;
   PairOutcome decode(const ImageView& frame, const MarkerPair& pair, MarkerObservation* out);
+  PairOutcome measure_predicted(const ImageView& frame, const PredictedMarker& predicted,
+                                MarkerObservation* out);
   static Refusal refusal_without_markers(const FrameResult& result, size_t pair_count);
 
   PipelineConfig config_;

@@ -169,7 +169,8 @@ std::map<std::tuple<int, int, int>, double>& drive_median_ns() {
 }
 
 // The daemon's path on a moving robot (filter on), each frame swept whole
-// (tracking off) or, with the fix, only in the predicted windows: thread CPU
+// (tracking 0) or, with the fix, only in the predicted windows (1) or at the
+// predicted markers' edges and dots alone (2, detector.track_edges): thread CPU
 // time of Localizer::localize per frame, median over every frame of every
 // pass through the sequence (the filter restarts at each pass).
 // The camera formats BM_Drive's "format" argument indexes.
@@ -179,7 +180,8 @@ constexpr PixelFormat kDriveFormats[] = {PixelFormat::kRgb24, PixelFormat::kYuyv
 void BM_Drive(benchmark::State& state) {
   const int width_px = static_cast<int>(state.range(0));
   const int format = static_cast<int>(state.range(1));
-  const bool tracking = state.range(2) != 0;
+  const int tracking_mode = static_cast<int>(state.range(2));
+  const bool tracking = tracking_mode != 0;
   const std::vector<Image>& frames = drive_frames(width_px, kDriveFormats[format]);
   if (frames.size() != kDriveFrames) {
     state.SkipWithError("the drive set did not render");
@@ -187,6 +189,7 @@ void BM_Drive(benchmark::State& state) {
   }
   PipelineConfig config = config_for(width_px);
   config.detector.tracking = tracking;
+  config.detector.track_edges = tracking_mode == 2;
   config = with_mode(config, PositioningMode::kAuto, true);
   auto localizer = std::make_unique<Localizer>(config);
   std::vector<double> frame_cpu_ns;
@@ -220,7 +223,7 @@ void BM_Drive(benchmark::State& state) {
   const double n = static_cast<double>(state.iterations());
   const double med = median(frame_cpu_ns);
   state.counters["swept_share"] = swept / n;
-  drive_median_ns()[{width_px, format, tracking ? 1 : 0}] = med;
+  drive_median_ns()[{width_px, format, tracking_mode}] = med;
   for (int s = 0; s < kStageCount; ++s) {
     state.counters[std::string(Pipeline::stage_name(s)) + "_us"] = median(stage_ns[s]) * 1e-3;
   }
@@ -369,7 +372,7 @@ BENCHMARK(BM_Pipeline)
     ->Args({640, 25})
     ->Unit(benchmark::kMicrosecond);
 BENCHMARK(BM_Drive)
-    ->ArgsProduct({{320, 640, 1280}, {0, 1, 2}, {0, 1}})
+    ->ArgsProduct({{320, 640, 1280}, {0, 1, 2}, {0, 1, 2}})
     ->ArgNames({"width", "format", "tracking"})
     ->Unit(benchmark::kMicrosecond);
 BENCHMARK(BM_MjpegDecode)
@@ -399,17 +402,26 @@ void print_summary() {
   }
   if (drive_median_ns().empty()) return;
   std::printf("\ndrive set, filter on (medians of thread CPU time per frame, ms; x AprilTag d2)\n");
-  std::printf("%-10s %-6s %16s %16s %8s\n", "size", "pixels", "full sweeps", "tracked", "ratio");
+  std::printf("%-10s %-6s %16s %16s %8s %16s %8s\n", "size", "pixels", "full sweeps", "tracked",
+              "ratio", "edges tracked", "ratio");
   for (int width_px : {320, 640, 1280}) {
     for (int format : {0, 1, 2}) {
       const auto full = drive_median_ns().find({width_px, format, 0});
-      const auto tracked = drive_median_ns().find({width_px, format, 1});
-      if (full == drive_median_ns().end() || tracked == drive_median_ns().end()) continue;
+      if (full == drive_median_ns().end()) continue;
       const auto tag = apriltag_median_ns().find({width_px, 2});
       const double tag_ns = tag == apriltag_median_ns().end() ? 0.0 : tag->second;
-      std::printf("%4dx%-5d %-6s %7.3f (%5.1fx) %7.3f (%5.1fx) %8.2f\n", width_px, width_px * 3 / 4,
-                  to_string(kDriveFormats[format]), full->second * 1e-6, tag_ns / full->second,
-                  tracked->second * 1e-6, tag_ns / tracked->second, tracked->second / full->second);
+      std::printf("%4dx%-5d %-6s %7.3f (%5.1fx)", width_px, width_px * 3 / 4,
+                  to_string(kDriveFormats[format]), full->second * 1e-6, tag_ns / full->second);
+      for (int mode : {1, 2}) {
+        const auto tracked = drive_median_ns().find({width_px, format, mode});
+        if (tracked == drive_median_ns().end()) {
+          std::printf(" %16s %8s", "-", "-");
+          continue;
+        }
+        std::printf(" %7.3f (%5.1fx) %8.2f", tracked->second * 1e-6, tag_ns / tracked->second,
+                    tracked->second / full->second);
+      }
+      std::printf("\n");
     }
   }
 }

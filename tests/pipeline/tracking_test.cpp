@@ -7,8 +7,10 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdio>
+#include <memory>
 #include <numbers>
 #include <span>
 #include <vector>
@@ -187,6 +189,21 @@ TEST(PlanTracking, WindowsHoldEveryWholeMarkerAndGrowWithThePredictionsErrors) {
     });
     EXPECT_TRUE(inside) << "marker " << m.i << "," << m.j;
   }
+  // Each marker whole beyond doubt is predicted where the independent
+  // renderer's projection puts its centre (the pose is exact here), with
+  // the right codes, and its frame's North is the layout's 12 in long.
+  ASSERT_EQ(plan.predicted_span().size(), static_cast<size_t>(plan.expected_whole));
+  for (const PredictedMarker& pm : plan.predicted_span()) {
+    const auto truth = std::find_if(whole.begin(), whole.end(), [&](const auto& m) {
+      return m.i == pm.code_i && m.j == pm.code_j;
+    });
+    ASSERT_NE(truth, whole.end()) << "predicted " << pm.code_i << "," << pm.code_j;
+    EXPECT_NEAR(pm.frame.centre_u_px, truth->centre_u_px, 0.05);
+    EXPECT_NEAR(pm.frame.centre_v_px, truth->centre_v_px, 0.05);
+    // Level camera, default heights: 530 px / (2.4384 - 0.3048) m.
+    EXPECT_NEAR(std::hypot(pm.frame.north_u, pm.frame.north_v), 530.0 / 2.1336, 0.05);
+    EXPECT_NEAR(pm.frame.east_u * pm.frame.north_u + pm.frame.east_v * pm.frame.north_v, 0.0, 1.0);
+  }
   int64_t area_px = 0;
   for (const PixelWindow& w : plan.span()) area_px += w.area_px();
   EXPECT_LT(area_px, 640 * 480 / 2);
@@ -201,6 +218,47 @@ TEST(PlanTracking, WindowsHoldEveryWholeMarkerAndGrowWithThePredictionsErrors) {
   PredictionErrors lost;
   for (int k = 0; k < 6; ++k) lost.add(0.5, 0.5);
   EXPECT_EQ(plan_tracking(view, config.detector, s, lost, &plan), FullSweepReason::kUncertain);
+}
+
+// An edge-tracked frame reads each predicted marker's codes where the plan
+// puts it and keeps only a marker whose codes are the predicted ones: a
+// prediction naming another marker there (a robot set down a grid unit
+// away) is refused, never positioned with.
+TEST(PlanTracking, EdgeTrackedMarkersMustReadTheirPredictedCodes) {
+  const XPose pose{2.1, 2.0, 0.3};
+  const PipelineConfig config = config_for(XCamera{});
+  const ViewGeometry view(config);
+  MotionState s;
+  s.x[0] = pose.x_m, s.x[1] = pose.y_m, s.x[2] = pose.yaw_rad;
+  PredictionErrors errors;
+  for (int k = 0; k < 6; ++k) errors.add(0.0002, 0.0002);
+  TrackingPlan plan;
+  ASSERT_EQ(plan_tracking(view, config.detector, s, errors, &plan), FullSweepReason::kNone);
+  ASSERT_GE(plan.expected_whole, 4);
+  XRenderOptions options;
+  options.noise_sigma = 2.0;
+  const cv::Mat rgb = render_rgb(XCamera{}, XMount{}, pose, options);
+  Image image(rgb.cols, rgb.rows, PixelFormat::kRgb24);
+  for (int y = 0; y < rgb.rows; ++y) std::copy_n(rgb.ptr(y), rgb.cols * 3, image.row(y));
+  Pipeline pipeline(config);
+  auto result = std::make_unique<FrameResult>();
+  pipeline.process_tracked(image.view(), PositioningMode::kAuto, result.get(), {},
+                           plan.predicted_span());
+  EXPECT_EQ(result->marker_count, plan.expected_whole);
+  ASSERT_TRUE(result->estimate.valid);
+  EXPECT_NEAR(result->estimate.pose.x_m, pose.x_m, 0.001);
+  EXPECT_NEAR(result->estimate.pose.y_m, pose.y_m, 0.001);
+  EXPECT_EQ(result->swept_px, 0) << "no pixel classified";
+
+  std::array<PredictedMarker, kMaxMarkersPerFrame> shifted = plan.predicted;
+  for (int k = 0; k < plan.expected_whole; ++k)
+    shifted[static_cast<size_t>(k)].code_i = (shifted[static_cast<size_t>(k)].code_i + 1) % 8;
+  pipeline.process_tracked(
+      image.view(), PositioningMode::kAuto, result.get(), {},
+      std::span<const PredictedMarker>(shifted.data(), static_cast<size_t>(plan.expected_whole)));
+  EXPECT_EQ(result->marker_count, 0);
+  EXPECT_EQ(result->rejects.inconsistent, plan.expected_whole);
+  EXPECT_FALSE(result->estimate.valid);
 }
 
 // --- the localizer: tracked against whole, frame by frame --------------------
@@ -231,11 +289,13 @@ struct Compared {
   std::vector<double> error_full_mm, error_tracked_mm;
 };
 
-Compared compare(int frames, PixelFormat format, const XCamera& camera = {}) {
+Compared compare(int frames, PixelFormat format, const XCamera& camera = {},
+                 bool track_edges = false) {
   PipelineConfig config = with_mode(config_for(camera), PositioningMode::kAuto, true);
   PipelineConfig whole = config;
   whole.detector.tracking = false;
   config.detector.tracking = true;
+  config.detector.track_edges = track_edges;
   Localizer tracking(config), full(whole);
   Compared c;
   for (int k = 0; k < frames; ++k) {
@@ -299,12 +359,23 @@ double p99(const std::vector<double>& sorted) {
 // track (the sanitizer builds run the first sixth of the path).
 constexpr int kWarmUpFrames = 7;
 
-void expect_tracking_changes_nothing(const Compared& c, double tracked_share) {
+// The windows' sweep changes no pose by more than 0.5 mm nor the p99 by
+// more than 0.02 mm; edge-tracked frames (no centroids) are allowed what
+// they were measured to cost: p99 +0.015 to +0.10 mm, differences up to
+// 0.53 mm (2026-12-05, the cases below).
+struct TrackingLimits {
+  double max_difference_mm = 0.5;
+  double p99_increase_mm = 0.02;
+};
+constexpr TrackingLimits kEdgeLimits{0.65, 0.15};
+
+void expect_tracking_changes_nothing(const Compared& c, double tracked_share,
+                                     const TrackingLimits& limits = {}) {
   EXPECT_GE(c.tracked, static_cast<int>(tracked_share * (c.frames - kWarmUpFrames)));
   EXPECT_EQ(c.valid_only_tracked, 0) << "a pose where the whole frame gave none";
   EXPECT_EQ(c.valid_tracked, c.valid_full) << "tracking lost frames";
-  EXPECT_LE(c.max_difference_mm, 0.5);
-  EXPECT_LE(p99(c.error_tracked_mm), p99(c.error_full_mm) + 0.02);
+  EXPECT_LE(c.max_difference_mm, limits.max_difference_mm);
+  EXPECT_LE(p99(c.error_tracked_mm), p99(c.error_full_mm) + limits.p99_increase_mm);
 }
 
 TEST(TrackedLocalizer, AnArcAPauseReversingAJumpAndATurnGiveTheFullSweepsPoses) {
@@ -343,6 +414,33 @@ TEST(TrackedLocalizer, AWideAngleOffCentreCameraTracksAsTheDefaultDoes) {
   expect_tracking_changes_nothing(c, 0.4);
 }
 
+// detector.track_edges: tracked frames measured at the predicted markers'
+// edges and dots alone, on the same paths and cameras. Measured
+// (2026-12-05): as many frames tracked and valid as the windows; p99
+// 0.334 -> 0.438 mm (RGB), 0.436 -> 0.451 (YUYV), 0.394 -> 0.448 (NV12),
+// the wide-angle camera's largest difference 0.53 mm.
+TEST(TrackedLocalizer, EdgeTrackedFramesOnAnArcAPauseReversingAJumpAndATurn) {
+  const Compared c = compare(testing::accuracy_frames(120), PixelFormat::kRgb24, {}, true);
+  expect_tracking_changes_nothing(c, 0.65, kEdgeLimits);
+  if (c.frames > 86) {
+    EXPECT_GE(c.track_failed, 1) << "the jump must fail the track";
+  }
+}
+
+TEST(TrackedLocalizer, EdgeTrackedYuyvAndNv12Frames) {
+  for (PixelFormat format : {PixelFormat::kYuyv, PixelFormat::kNv12}) {
+    SCOPED_TRACE(static_cast<int>(format));
+    const Compared c = compare(testing::accuracy_frames(60), format, {}, true);
+    expect_tracking_changes_nothing(c, 0.55, kEdgeLimits);
+  }
+}
+
+TEST(TrackedLocalizer, EdgeTrackedFramesOfAWideAngleOffCentreCamera) {
+  const XCamera wide{640, 480, 540.0, 520.0, 331.5, 228.5, {-0.35, 0.12, 0.0, 0.0, -0.015}};
+  const Compared c = compare(testing::accuracy_frames(60), PixelFormat::kRgb24, wide, true);
+  expect_tracking_changes_nothing(c, 0.4, kEdgeLimits);
+}
+
 TEST(TrackedLocalizer, GreyFramesNeverTrackAndGiveNoPose) {
   const Compared c = compare(testing::accuracy_frames(10), PixelFormat::kGray8);
   EXPECT_EQ(c.tracked, 0);
@@ -350,8 +448,11 @@ TEST(TrackedLocalizer, GreyFramesNeverTrackAndGiveNoPose) {
 }
 
 // The simulator's drive through a rolling shutter of 25 ms (the independent
-// renderer has none): filter, tracking and the readout's motion all on.
-TEST(TrackedLocalizer, ATrackedFrameWithARollingShutterAllocatesNothing) {
+// renderer has none): filter, tracking (windows, and edges) and the
+// readout's motion all on.
+class TrackedAllocation : public ::testing::TestWithParam<bool> {};
+
+TEST_P(TrackedAllocation, ATrackedFrameWithARollingShutterAllocatesNothing) {
   constexpr double kReadout_s = 0.025;
   sim::SceneOptions options;
   options.intrinsics.readout_ms = 1e3 * kReadout_s;
@@ -365,6 +466,7 @@ TEST(TrackedLocalizer, ATrackedFrameWithARollingShutterAllocatesNothing) {
   }
   PipelineConfig config = with_mode(PipelineConfig{}, PositioningMode::kAuto, true);
   config.intrinsics.readout_ms = options.intrinsics.readout_ms;
+  config.detector.track_edges = GetParam();
   Localizer localizer(config);
   FrameInfo info;
   auto localize = [&](size_t k) -> const Localization& {
@@ -378,6 +480,11 @@ TEST(TrackedLocalizer, ATrackedFrameWithARollingShutterAllocatesNothing) {
   EXPECT_EQ(test::stop_counting_allocations(), 0);
   EXPECT_GE(tracked, 6);
 }
+
+INSTANTIATE_TEST_SUITE_P(WindowsAndEdges, TrackedAllocation, ::testing::Bool(),
+                         [](const ::testing::TestParamInfo<bool>& p) {
+                           return p.param ? "Edges" : "Windows";
+                         });
 
 }  // namespace
 }  // namespace ceilpose
