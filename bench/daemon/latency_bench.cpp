@@ -97,11 +97,15 @@ void BM_FrameToPose(benchmark::State& state, bool replay) {
   const bool loaded = state.range(1) != 0;
   // The synthetic camera hands over YUYV, as a USB camera does (issue 29).
   const bool yuyv = !replay && state.range(2) != 0;
+  // Tracked frames measured at the predicted markers' edges alone
+  // (detector.track_edges).
+  const bool edges = !replay && state.range(3) != 0;
 
   ServiceConfig config = default_config();
   config.capture.device.fps = fps;
   config.capture.thread.cpu = 0;  // capture on CPU 0; the load (if any) on CPU 1
   config.watchdog.status_interval_ms = 1000;
+  config.pipeline.detector.track_edges = edges;
   std::string spec = "synthetic";
   capture::SourceOptions so = config.capture.device;
   sim::TrajectoryCameraOptions camera;
@@ -181,7 +185,8 @@ void register_all() {
     if (replay)
       b->ArgsProduct({{30, 60, 120}, {0, 1}})->ArgNames({"fps", "load"});
     else
-      b->ArgsProduct({{30, 60, 120}, {0, 1}, {0, 1}})->ArgNames({"fps", "load", "yuyv"});
+      b->ArgsProduct({{30, 60, 120}, {0, 1}, {0, 1}, {0, 1}})
+          ->ArgNames({"fps", "load", "yuyv", "edges"});
     b->Iterations(1)->UseManualTime()->Unit(benchmark::kMillisecond);
   }
 }
