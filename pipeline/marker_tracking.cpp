@@ -101,6 +101,7 @@ FullSweepReason plan_tracking(const ViewGeometry& view, const DetectorParams& pa
   plan->margin_px = margin_px;
   plan->window_count = 0;
   plan->expected_whole = 0;
+  plan->predicted_count = 0;
   if (!errors.known()) return FullSweepReason::kNoFix;
   if (!std::isfinite(margin_px)) return FullSweepReason::kUncertain;
 
@@ -185,15 +186,18 @@ FullSweepReason plan_tracking(const ViewGeometry& view, const DetectorParams& pa
       // Whole beyond doubt: inside the frame even if the prediction is off
       // by the whole margin.
       if (x0 >= 0.0 && y0 >= 0.0 && x1 <= w && y1 <= h) {
-        // Its frame where its centre row is exposed (the prediction is the
-        // centre row's): two passes find the row.
-        PredictedMarker& pm = plan->predicted[static_cast<size_t>(plan->expected_whole)];
-        pm.code_i = i;
-        pm.code_j = j;
-        bool framed = marker_frame_at(view, *p, s, 0.0, &pm.frame);
-        if (framed && k.readout_ms > 0.0)
-          framed = marker_frame_at(view, *p, s, row_time_s(k, pm.frame.centre_v_px), &pm.frame);
-        if (!framed) return FullSweepReason::kUncertain;
+        if (params.track_edges) {
+          // Its frame where its centre row is exposed (the prediction is the
+          // centre row's): two passes find the row.
+          PredictedMarker& pm = plan->predicted[static_cast<size_t>(plan->predicted_count)];
+          pm.code_i = i;
+          pm.code_j = j;
+          bool framed = marker_frame_at(view, *p, s, 0.0, &pm.frame);
+          if (framed && k.readout_ms > 0.0)
+            framed = marker_frame_at(view, *p, s, row_time_s(k, pm.frame.centre_v_px), &pm.frame);
+          if (!framed) return FullSweepReason::kUncertain;
+          ++plan->predicted_count;
+        }
         plan->whole[plan->expected_whole++] = j * codes + i;
       }
     }

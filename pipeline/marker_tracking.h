@@ -42,10 +42,13 @@ struct TrackingPlan {
   // sweep does not was not where its window looked.
   std::array<int32_t, kMaxMarkersPerFrame> whole{};
   int expected_whole = 0;
-  // The same markers, where they will be (whole[k] is predicted[k]'s).
+  // With detector.track_edges, the same markers where they will be
+  // (whole[k] is predicted[k]'s); none otherwise (no work a windows' sweep
+  // would not read).
   std::array<PredictedMarker, kMaxMarkersPerFrame> predicted{};
+  int predicted_count = 0;
   std::span<const PredictedMarker> predicted_span() const {
-    return {predicted.data(), static_cast<size_t>(expected_whole)};
+    return {predicted.data(), static_cast<size_t>(predicted_count)};
   }
   double margin_px = 0.0;
   std::span<const PixelWindow> span() const {

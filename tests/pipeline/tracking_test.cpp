@@ -167,7 +167,8 @@ TEST(MergeWindows, OverlappingOrTouchingWindowsBecomeTheirBoxAndOthersStay) {
 // --- the plan ----------------------------------------------------------------
 
 TEST(PlanTracking, WindowsHoldEveryWholeMarkerAndGrowWithThePredictionsErrors) {
-  const PipelineConfig config;
+  PipelineConfig config;
+  config.detector.track_edges = true;  // the predicted markers too
   const ViewGeometry view(config);
   MotionState s;
   s.x[0] = 2.1, s.x[1] = 2.0, s.x[2] = 0.3;
@@ -193,6 +194,13 @@ TEST(PlanTracking, WindowsHoldEveryWholeMarkerAndGrowWithThePredictionsErrors) {
   // renderer's projection puts its centre (the pose is exact here), with
   // the right codes, and its frame's North is the layout's 12 in long.
   ASSERT_EQ(plan.predicted_span().size(), static_cast<size_t>(plan.expected_whole));
+  PipelineConfig windows_only = config;
+  windows_only.detector.track_edges = false;
+  TrackingPlan windows_plan;
+  ASSERT_EQ(plan_tracking(view, windows_only.detector, s, errors, &windows_plan),
+            FullSweepReason::kNone);
+  EXPECT_TRUE(windows_plan.predicted_span().empty()) << "nothing predicted a sweep will not read";
+  EXPECT_EQ(windows_plan.expected_whole, plan.expected_whole);
   for (const PredictedMarker& pm : plan.predicted_span()) {
     const auto truth = std::find_if(whole.begin(), whole.end(), [&](const auto& m) {
       return m.i == pm.code_i && m.j == pm.code_j;
@@ -226,7 +234,8 @@ TEST(PlanTracking, WindowsHoldEveryWholeMarkerAndGrowWithThePredictionsErrors) {
 // away) is refused, never positioned with.
 TEST(PlanTracking, EdgeTrackedMarkersMustReadTheirPredictedCodes) {
   const XPose pose{2.1, 2.0, 0.3};
-  const PipelineConfig config = config_for(XCamera{});
+  PipelineConfig config = config_for(XCamera{});
+  config.detector.track_edges = true;
   const ViewGeometry view(config);
   MotionState s;
   s.x[0] = pose.x_m, s.x[1] = pose.y_m, s.x[2] = pose.yaw_rad;
