@@ -104,7 +104,8 @@ class Pipeline {
 
   // A tracked frame measured where the prediction puts each marker (plan_tracking's
   // predicted markers, detector.track_edges): its edges and dots only, no
-  // classification, no components (pairs() then stays empty). A marker
+  // classification, no components (rectangles() and pairs() then stay
+  // empty; components() keep the last sweep's). A marker
   // whose codes read otherwise than predicted is rejected as inconsistent.
   void process_tracked(const ImageView& frame, PositioningMode mode, FrameResult* out,
                        const CameraMotion& motion, std::span<const PredictedMarker> predicted);
