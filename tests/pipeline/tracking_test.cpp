@@ -206,10 +206,10 @@ TEST(PlanTracking, WindowsHoldEveryWholeMarkerAndGrowWithThePredictionsErrors) {
       return m.i == pm.code_i && m.j == pm.code_j;
     });
     ASSERT_NE(truth, whole.end()) << "predicted " << pm.code_i << "," << pm.code_j;
-    EXPECT_NEAR(pm.frame.centre_u_px, truth->centre_u_px, 0.05);
-    EXPECT_NEAR(pm.frame.centre_v_px, truth->centre_v_px, 0.05);
+    EXPECT_NEAR(pm.frame.centre_u_px, truth->centre_u_px, 0.02);
+    EXPECT_NEAR(pm.frame.centre_v_px, truth->centre_v_px, 0.02);
     // Level camera, default heights: 530 px / (2.4384 - 0.3048) m.
-    EXPECT_NEAR(std::hypot(pm.frame.north_u, pm.frame.north_v), 530.0 / 2.1336, 0.05);
+    EXPECT_NEAR(std::hypot(pm.frame.north_u, pm.frame.north_v), 530.0 / 2.1336, 0.02);
     EXPECT_NEAR(pm.frame.east_u * pm.frame.north_u + pm.frame.east_v * pm.frame.north_v, 0.0, 1.0);
   }
   int64_t area_px = 0;
@@ -228,28 +228,43 @@ TEST(PlanTracking, WindowsHoldEveryWholeMarkerAndGrowWithThePredictionsErrors) {
   EXPECT_EQ(plan_tracking(view, config.detector, s, lost, &plan), FullSweepReason::kUncertain);
 }
 
+// An edge-tracked frame of the independent renderer at `pose`, and the plan
+// an exact, confident prediction of it makes.
+struct EdgeTrackedScene {
+  PipelineConfig config;
+  TrackingPlan plan;
+  Image image;
+};
+
+EdgeTrackedScene edge_tracked_scene(const XPose& pose) {
+  EdgeTrackedScene scene{config_for(XCamera{}), {}, {}};
+  scene.config.detector.track_edges = true;
+  const ViewGeometry view(scene.config);
+  MotionState s;
+  s.x[0] = pose.x_m, s.x[1] = pose.y_m, s.x[2] = pose.yaw_rad;
+  PredictionErrors errors;
+  for (int k = 0; k < 6; ++k) errors.add(0.0002, 0.0002);
+  EXPECT_EQ(plan_tracking(view, scene.config.detector, s, errors, &scene.plan),
+            FullSweepReason::kNone);
+  XRenderOptions options;
+  options.noise_sigma = 2.0;
+  const cv::Mat rgb = render_rgb(XCamera{}, XMount{}, pose, options);
+  scene.image = Image(rgb.cols, rgb.rows, PixelFormat::kRgb24);
+  for (int y = 0; y < rgb.rows; ++y) std::copy_n(rgb.ptr(y), rgb.cols * 3, scene.image.row(y));
+  return scene;
+}
+
 // An edge-tracked frame reads each predicted marker's codes where the plan
 // puts it and keeps only a marker whose codes are the predicted ones: a
 // prediction naming another marker there (a robot set down a grid unit
 // away) is refused, never positioned with.
 TEST(PlanTracking, EdgeTrackedMarkersMustReadTheirPredictedCodes) {
   const XPose pose{2.1, 2.0, 0.3};
-  PipelineConfig config = config_for(XCamera{});
-  config.detector.track_edges = true;
-  const ViewGeometry view(config);
-  MotionState s;
-  s.x[0] = pose.x_m, s.x[1] = pose.y_m, s.x[2] = pose.yaw_rad;
-  PredictionErrors errors;
-  for (int k = 0; k < 6; ++k) errors.add(0.0002, 0.0002);
-  TrackingPlan plan;
-  ASSERT_EQ(plan_tracking(view, config.detector, s, errors, &plan), FullSweepReason::kNone);
+  const EdgeTrackedScene scene = edge_tracked_scene(pose);
+  const TrackingPlan& plan = scene.plan;
+  const Image& image = scene.image;
   ASSERT_GE(plan.expected_whole, 4);
-  XRenderOptions options;
-  options.noise_sigma = 2.0;
-  const cv::Mat rgb = render_rgb(XCamera{}, XMount{}, pose, options);
-  Image image(rgb.cols, rgb.rows, PixelFormat::kRgb24);
-  for (int y = 0; y < rgb.rows; ++y) std::copy_n(rgb.ptr(y), rgb.cols * 3, image.row(y));
-  Pipeline pipeline(config);
+  Pipeline pipeline(scene.config);
   auto result = std::make_unique<FrameResult>();
   pipeline.process_tracked(image.view(), PositioningMode::kAuto, result.get(), {},
                            plan.predicted_span());
@@ -268,6 +283,45 @@ TEST(PlanTracking, EdgeTrackedMarkersMustReadTheirPredictedCodes) {
   EXPECT_EQ(result->marker_count, 0);
   EXPECT_EQ(result->rejects.inconsistent, plan.expected_whole);
   EXPECT_FALSE(result->estimate.valid);
+}
+
+// A robot setting off from a pause is where the filter predicted it a
+// frame ago, 17 mm (4 px) behind: each profile then crosses its edge
+// off-centre, takes part of the blurred rise for a plateau, and the pose
+// was 0.25 mm off (frame 56 of the path below, 0.51 against 0.28 mm). The
+// edges are measured again around where they were found: predictions 4 px
+// off give the exact prediction's pose within 0.02 mm (measured 0.001-
+// 0.003 mm; without measuring again 0.16-0.25 mm).
+TEST(PlanTracking, EdgeTrackedMarkersFarFromTheirPredictionAreMeasuredWhereTheyAre) {
+  const EdgeTrackedScene scene = edge_tracked_scene({2.1, 2.0, 0.3});
+  const TrackingPlan& plan = scene.plan;
+  const Image& image = scene.image;
+  Pipeline pipeline(scene.config);
+  auto exact = std::make_unique<FrameResult>();
+  pipeline.process_tracked(image.view(), PositioningMode::kAuto, exact.get(), {},
+                           plan.predicted_span());
+  ASSERT_TRUE(exact->estimate.valid);
+  for (const auto& [du, dv] : {std::pair{4.0, 0.0}, {0.0, -4.0}, {-2.8, 2.8}}) {
+    SCOPED_TRACE(::testing::Message() << "predicted " << du << ", " << dv << " px off");
+    std::array<PredictedMarker, kMaxMarkersPerFrame> off = plan.predicted;
+    for (int k = 0; k < plan.expected_whole; ++k) {
+      off[static_cast<size_t>(k)].frame.centre_u_px += du;
+      off[static_cast<size_t>(k)].frame.centre_v_px += dv;
+    }
+    auto result = std::make_unique<FrameResult>();
+    pipeline.process_tracked(
+        image.view(), PositioningMode::kAuto, result.get(), {},
+        std::span<const PredictedMarker>(off.data(), static_cast<size_t>(plan.expected_whole)));
+    ASSERT_TRUE(result->estimate.valid);
+    EXPECT_EQ(result->marker_count, exact->marker_count);
+    const double difference_mm =
+        1e3 * std::hypot(result->estimate.pose.x_m - exact->estimate.pose.x_m,
+                         result->estimate.pose.y_m - exact->estimate.pose.y_m);
+    std::printf(
+        "[tracking] predicted %.1f, %.1f px off: pose %.4f mm from the exact prediction's\n", du,
+        dv, difference_mm);
+    EXPECT_LT(difference_mm, 0.02);
+  }
 }
 
 // --- the localizer: tracked against whole, frame by frame --------------------
@@ -296,7 +350,19 @@ struct Compared {
   int valid_full = 0, valid_tracked = 0, valid_only_tracked = 0;
   double max_difference_mm = 0.0;
   std::vector<double> error_full_mm, error_tracked_mm;
+  // The tracked frames' errors, and the whole sweep's of the same frames.
+  std::vector<double> paired_full_mm, paired_tracked_mm;
 };
+
+double median(const std::vector<double>& sorted) {
+  return sorted.empty() ? 0.0 : sorted[sorted.size() / 2];
+}
+
+double p99(const std::vector<double>& sorted) {
+  return sorted.empty()
+             ? 0.0
+             : sorted[std::min(sorted.size() - 1, static_cast<size_t>(0.99 * sorted.size()))];
+}
 
 Compared compare(int frames, PixelFormat format, const XCamera& camera = {},
                  bool track_edges = false) {
@@ -333,6 +399,10 @@ Compared compare(int frames, PixelFormat format, const XCamera& camera = {},
     };
     if (full_pose.valid) c.error_full_mm.push_back(error_mm(full_pose));
     if (b.measured.valid) c.error_tracked_mm.push_back(error_mm(b.measured));
+    if (full_pose.valid && b.measured.valid && b.tracked()) {
+      c.paired_full_mm.push_back(error_mm(full_pose));
+      c.paired_tracked_mm.push_back(error_mm(b.measured));
+    }
     if (full_pose.valid && b.measured.valid) {
       c.max_difference_mm =
           std::max(c.max_difference_mm, 1e3 * std::hypot(full_pose.pose.x_m - b.measured.pose.x_m,
@@ -341,11 +411,12 @@ Compared compare(int frames, PixelFormat format, const XCamera& camera = {},
   }
   EXPECT_EQ(tracking.sweeps().tracked(), static_cast<uint64_t>(c.tracked));
   EXPECT_EQ(tracking.sweeps().full(), static_cast<uint64_t>(c.frames - c.tracked));
-  std::sort(c.error_full_mm.begin(), c.error_full_mm.end());
-  std::sort(c.error_tracked_mm.begin(), c.error_tracked_mm.end());
+  for (auto* v : {&c.error_full_mm, &c.error_tracked_mm, &c.paired_full_mm, &c.paired_tracked_mm})
+    std::sort(v->begin(), v->end());
   std::printf(
       "[tracking] frames %d tracked %d (no fix %llu, uncertain %llu, scheduled %llu, "
-      "failed %d) valid %d/%d max difference %.3f mm\n",
+      "failed %d) valid %d/%d max difference %.3f mm, p99 full %.3f tracked %.3f mm, "
+      "tracked frames' median full %.3f tracked %.3f mm\n",
       c.frames, c.tracked,
       static_cast<unsigned long long>(
           tracking.sweeps().by_reason[static_cast<size_t>(FullSweepReason::kNoFix)]),
@@ -353,14 +424,9 @@ Compared compare(int frames, PixelFormat format, const XCamera& camera = {},
           tracking.sweeps().by_reason[static_cast<size_t>(FullSweepReason::kUncertain)]),
       static_cast<unsigned long long>(
           tracking.sweeps().by_reason[static_cast<size_t>(FullSweepReason::kScheduled)]),
-      c.track_failed, c.valid_tracked, c.valid_full, c.max_difference_mm);
+      c.track_failed, c.valid_tracked, c.valid_full, c.max_difference_mm, p99(c.error_full_mm),
+      p99(c.error_tracked_mm), median(c.paired_full_mm), median(c.paired_tracked_mm));
   return c;
-}
-
-double p99(const std::vector<double>& sorted) {
-  return sorted.empty()
-             ? 0.0
-             : sorted[std::min(sorted.size() - 1, static_cast<size_t>(0.99 * sorted.size()))];
 }
 
 // The filter's first frame and its first six predictions (three left out,
@@ -369,14 +435,21 @@ double p99(const std::vector<double>& sorted) {
 constexpr int kWarmUpFrames = 7;
 
 // The windows' sweep changes no pose by more than 0.5 mm nor the p99 by
-// more than 0.02 mm; edge-tracked frames (no centroids) are allowed what
-// they were measured to cost: p99 +0.015 to +0.10 mm, differences up to
-// 0.53 mm (2026-12-05, the cases below).
+// more than 0.02 mm, nor the tracked frames' median error. Edge-tracked
+// frames (no centroids, a different estimator) differ from the whole sweep
+// by up to 0.23 / 0.17 / 0.14 mm (RGB / YUYV / NV12) and 0.50 mm (the wide
+// angle camera), their p99 by +0.00 / +0.035 / +0.01 / -0.06 mm (a frame
+// that tracked one marker fewer), and the tracked frames' median error is
+// lower: 0.152 / 0.115 / 0.125 / 0.186 mm against the whole sweep's 0.234 /
+// 0.183 / 0.198 / 0.447 (2026-12-05, the cases below); on the arc alone
+// (the sanitizer builds' 24 frames) level with it, 0.118 / 0.125 / 0.131
+// against 0.108 / 0.129 / 0.123 mm.
 struct TrackingLimits {
   double max_difference_mm = 0.5;
   double p99_increase_mm = 0.02;
+  double median_increase_mm = 0.0;
 };
-constexpr TrackingLimits kEdgeLimits{0.65, 0.15};
+constexpr TrackingLimits kEdgeLimits{0.55, 0.05, 0.02};
 
 void expect_tracking_changes_nothing(const Compared& c, double tracked_share,
                                      const TrackingLimits& limits = {}) {
@@ -385,6 +458,7 @@ void expect_tracking_changes_nothing(const Compared& c, double tracked_share,
   EXPECT_EQ(c.valid_tracked, c.valid_full) << "tracking lost frames";
   EXPECT_LE(c.max_difference_mm, limits.max_difference_mm);
   EXPECT_LE(p99(c.error_tracked_mm), p99(c.error_full_mm) + limits.p99_increase_mm);
+  EXPECT_LE(median(c.paired_tracked_mm), median(c.paired_full_mm) + limits.median_increase_mm);
 }
 
 TEST(TrackedLocalizer, AnArcAPauseReversingAJumpAndATurnGiveTheFullSweepsPoses) {
