@@ -167,6 +167,12 @@ void BM_FrameToPose(benchmark::State& state, bool replay) {
     state.counters["p99_us"] = static_cast<double>(lat.p99_us);
     state.counters["max_us"] = static_cast<double>(lat.max_us);
     state.counters["cap_p99_us"] = static_cast<double>(cap.p99_us);
+    // The two parts of frame ready -> published: the pipeline thread's wake
+    // (dequeued -> pipeline started) and its work (started -> published).
+    state.counters["wake_p99_us"] =
+        static_cast<double>(worker.latency().dequeue_to_pipeline().summary().p99_us);
+    state.counters["work_p99_us"] =
+        static_cast<double>(worker.latency().pipeline_to_published().summary().p99_us);
     state.counters["frames"] = static_cast<double>(worker.frames());
     const double lost_first = static_cast<double>(half.skipped + half.drops);
     const double lost_all = static_cast<double>(end.skipped + end.drops);
