@@ -4,6 +4,7 @@
 #include <cmath>
 
 #include "core/camera_model.h"
+#include "pipeline/rectangle_ends.h"
 
 namespace ceilpose {
 
@@ -201,6 +202,16 @@ FullSweepReason plan_tracking(const ViewGeometry& view, const DetectorParams& pa
         plan->whole[plan->expected_whole++] = j * codes + i;
       }
     }
+  }
+  if (params.track_edges) {
+    // Edge-tracked frames sweep no window, so the windows' area does not
+    // matter: the profiles across each predicted edge must cross it, which
+    // they do while the prediction's likely error (the margin less its
+    // fixed part) stays within a profile's half-length. A marker found off
+    // its prediction is measured again where it is, or refused (pipeline).
+    const double error_px = margin_px - params.track_margin_px;
+    return error_px <= kEdgeProfileHalf_m * px_per_m ? FullSweepReason::kNone
+                                                     : FullSweepReason::kUncertain;
   }
   plan->window_count = merge_windows(plan->windows, plan->window_count);
   for (const PixelWindow& w : plan->span()) area_px += w.area_px();  // boxes: an upper bound

@@ -235,13 +235,21 @@ PairOutcome Pipeline::measure_predicted(const ImageView& frame, const PredictedM
   // plateau. When the marker lies more than kRecentreEdges_px from its
   // prediction (a robot setting off from a pause: 4 px, 0.5 mm off), the
   // edges are measured again around where they were found.
+  // Its edges must fix it both ways: ends alone leave it free along East,
+  // where nothing but the prediction would then place it (a prediction 8 px
+  // off put the pose 32 mm off, valid). Measured again, they must lie where
+  // they were found: otherwise the first profiles found something else.
+  // Either way the marker is refused rather than positioned with.
   double du = 0.0, dv = 0.0;
-  if (edge_shift_px(m, red_edges, green_edges, &du, &dv) &&
-      std::hypot(du, dv) > kRecentreEdges_px) {
+  if (!edge_shift_px(m, red_edges, green_edges, &du, &dv)) return PairOutcome::kInconsistent;
+  if (std::hypot(du, dv) > kRecentreEdges_px) {
     m.centre_u_px += du;
     m.centre_v_px += dv;
     red_edges = measure_edges(frame, m, true, layout);
     green_edges = measure_edges(frame, m, false, layout);
+    if (!edge_shift_px(m, red_edges, green_edges, &du, &dv) ||
+        std::hypot(du, dv) > kRecentreEdges_px)
+      return PairOutcome::kInconsistent;
   }
   MarkerObservation& o = *out;
   o.code_i = code_i.code;

@@ -24,8 +24,6 @@ constexpr double kSideProfileOffset_m = 0.6 * kInch_m;
 constexpr double kMinContrast = 30.0;
 // A tile at or above this level (darkest channel) is clipped.
 constexpr double kClipLevel = 250.0;
-// Each profile runs from this far inside the edge to as far outside it.
-constexpr double kProfileHalf_m = 1.0 * kInch_m;
 
 // The darkest channel at an image point, bilinear; negative outside the
 // frame. Red and green print far below the tile in it.
@@ -51,10 +49,10 @@ struct Crossings {
 // per pixel. False when it leaves the frame or the contrast is too low.
 bool profile(const ImageView& frame, const MarkerFrame& marker, double e_m, double n_m, double de,
              double dn, int samples, Crossings* out) {
-  const double step_m = 2.0 * kProfileHalf_m / (samples - 1);
+  const double step_m = 2.0 * kEdgeProfileHalf_m / (samples - 1);
   std::array<double, kMaxSamples> level;  // samples of them written before any is read
   for (int k = 0; k < samples; ++k) {
-    const double s_m = -kProfileHalf_m + k * step_m;
+    const double s_m = -kEdgeProfileHalf_m + k * step_m;
     double u = 0.0, v = 0.0;
     marker.project(e_m + s_m * de, n_m + s_m * dn, &u, &v);
     level[k] = darkest_at(frame, u, v);
@@ -67,7 +65,7 @@ bool profile(const ImageView& frame, const MarkerFrame& marker, double e_m, doub
     const double target = low + fraction * (high - low);
     for (int k = 1; k < samples; ++k) {
       if (level[k] >= target && level[k - 1] < target)
-        return -kProfileHalf_m +
+        return -kEdgeProfileHalf_m +
                ((k - 1) + (target - level[k - 1]) / (level[k] - level[k - 1])) * step_m;
     }
     return static_cast<double>(NAN);
@@ -88,7 +86,7 @@ bool profile(const ImageView& frame, const MarkerFrame& marker, double e_m, doub
     const double rise = std::clamp((level[k] - low) / (high - low), 0.0, 1.0);
     shortfall_m += (k == 0 || k == samples - 1 ? 0.5 : 1.0) * (1.0 - rise) * step_m;
   }
-  out->at_edge = -kProfileHalf_m + shortfall_m;
+  out->at_edge = -kEdgeProfileHalf_m + shortfall_m;
   return true;
 }
 
@@ -147,7 +145,7 @@ RectangleEdges measure_edges(const ImageView& frame, const MarkerFrame& marker, 
   const double px_per_m = std::hypot(marker.north_u, marker.north_v);
   if (!(px_per_m > 0.0)) return out;
   const int samples =
-      std::clamp(static_cast<int>(2.0 * kProfileHalf_m * px_per_m) + 1, 5, kMaxSamples);
+      std::clamp(static_cast<int>(2.0 * kEdgeProfileHalf_m * px_per_m) + 1, 5, kMaxSamples);
   double spread_sum_m = 0.0;
   int spreads = 0;
   for (int s = 0; s < 2; ++s) {

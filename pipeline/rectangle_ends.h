@@ -17,6 +17,11 @@
 
 namespace ceilpose {
 
+// Each profile runs from this far inside its edge to as far outside it: an
+// edge more than about half of it from where the profile was placed is not
+// measured truly (edge-tracked frames place them by a prediction).
+inline constexpr double kEdgeProfileHalf_m = 1.0 * kInch_m;
+
 struct EdgeCrossing {
   bool found = false;
   // The marker point (e_m, n_m) on the edge and its image, distorted
