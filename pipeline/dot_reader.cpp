@@ -121,7 +121,8 @@ float dot_threshold_ratio(const DetectorParams& params, double blur_px, double r
 
 CodeReading read_code(const ImageView& frame, const MarkerFrame& marker, bool red,
                       const CeilingLayout& layout, const DetectorParams& params,
-                      float threshold_ratio) {
+                      float threshold_ratio, double search_m) {
+  if (search_m < 0.0) search_m = params.dot_search_m;
   CodeReading out;
   const double e_m = red ? layout.red_centre_e_m() : layout.green_centre_e_m();
   const double dot_e_m = red ? layout.red_dot_e_m : layout.green_dot_e_m;
@@ -146,14 +147,14 @@ CodeReading read_code(const ImageView& frame, const MarkerFrame& marker, bool re
   if (reference[0] < 1.0 || reference[1] < 1.0) return out;
   const double px_per_m = std::hypot(marker.north_u, marker.north_v);
   // One pixel, or a sixth of the dot's height in large images.
-  const double step_m = std::max(px_per_m > 0.0 ? 1.0 / px_per_m : params.dot_search_m,
+  const double step_m = std::max(px_per_m > 0.0 ? 1.0 / px_per_m : search_m,
                                  (red ? layout.red_dot_n_m : layout.green_dot_n_m) / 6.0);
-  const int search_steps = std::clamp(static_cast<int>(params.dot_search_m / step_m), 0, 32);
+  const int search_steps = std::clamp(static_cast<int>(search_m / step_m), 0, 32);
   int code = 0;
   double margin = 1.0;
   for (int k = 0; k < layout.bits; ++k) {
     // The dot's darkest line: lines across the slot (three points, a
-    // quarter of the dot's width apart) a pixel apart over ±dot_search_m
+    // quarter of the dot's width apart) a pixel apart over ±search_m
     // along North; the darkest is the dot's core wherever blur, a rectangle
     // eaten by glare or a slightly wrong scale put it. The search stays
     // clear of the neighbouring slots' dots (pitch 4 in).

@@ -42,11 +42,12 @@ struct CodeReading {
 float dot_threshold_ratio(const DetectorParams& params, double blur_px, double red_dot_px);
 
 // Reads the `layout.bits` slots of the red (x code) or green (y code)
-// rectangle against `threshold_ratio` (dot_threshold_ratio()). Sparse reads
-// of the original frame: no allocation.
+// rectangle against `threshold_ratio` (dot_threshold_ratio()), each dot's
+// darkest line sought within ±search_m along North of its slot (negative:
+// params.dot_search_m). Sparse reads of the original frame: no allocation.
 CodeReading read_code(const ImageView& frame, const MarkerFrame& marker, bool red,
                       const CeilingLayout& layout, const DetectorParams& params,
-                      float threshold_ratio);
+                      float threshold_ratio, double search_m = -1.0);
 
 // Whether the dark pixels found inside a rectangle fit the dots its code
 // says it has: more dark area than the dots plus slack means dirt, an

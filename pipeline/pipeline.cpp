@@ -18,6 +18,9 @@ constexpr int kMaxRectangles = 256;
 // How far an edge-tracked marker may lie from its prediction, pixels, before
 // its edges are measured again around where they were found.
 constexpr double kRecentreEdges_px = 1.0;
+// How far along North an edge-tracked marker's dots are sought from their
+// slots (a whole sweep: detector.dot_search_m, 1 in).
+constexpr double kTrackedDotSearch_m = 0.25 * kInch_m;
 
 void check_size(const CameraIntrinsics& k) {
   if (k.width <= 0 || k.height <= 0) {
@@ -89,8 +92,8 @@ bool Pipeline::usable(const ImageView& frame) const {
 // frame and its red rectangle's edges (a whole sweep's decode and an
 // edge-tracked frame's alike).
 PairOutcome Pipeline::read_codes(const ImageView& frame, const MarkerFrame& m,
-                                 const RectangleEdges& red_edges, CodeReading* code_i,
-                                 CodeReading* code_j) const {
+                                 const RectangleEdges& red_edges, double dot_search_m,
+                                 CodeReading* code_i, CodeReading* code_j) const {
   const CeilingLayout& layout = config_.layout;
   // Blur first: it decides whether the dots can be read and where their
   // threshold lies.
@@ -98,8 +101,8 @@ PairOutcome Pipeline::read_codes(const ImageView& frame, const MarkerFrame& m,
   const double blur_px = red_edges.spread_px;
   if (blur_px > config_.detector.max_blur_to_dot * red_dot_px) return PairOutcome::kBlurred;
   const float threshold = dot_threshold_ratio(config_.detector, blur_px, red_dot_px);
-  *code_i = read_code(frame, m, true, layout, config_.detector, threshold);
-  *code_j = read_code(frame, m, false, layout, config_.detector, threshold);
+  *code_i = read_code(frame, m, true, layout, config_.detector, threshold, dot_search_m);
+  *code_j = read_code(frame, m, false, layout, config_.detector, threshold, dot_search_m);
   if (!code_i->ok || !code_j->ok) return PairOutcome::kUnreadable;
   if (std::min(code_i->margin, code_j->margin) < config_.detector.dot_min_margin)
     return PairOutcome::kAmbiguous;
@@ -170,7 +173,8 @@ PairOutcome Pipeline::decode(const ImageView& frame, const MarkerPair& pair,
   const double px_per_m = std::hypot(m.north_u, m.north_v);
   const RectangleEdges red_edges = measure_edges(frame, m, true, layout);
   CodeReading code_i, code_j;
-  const PairOutcome read = read_codes(frame, m, red_edges, &code_i, &code_j);
+  const PairOutcome read =
+      read_codes(frame, m, red_edges, config_.detector.dot_search_m, &code_i, &code_j);
   if (read != PairOutcome::kDecoded) return read;
   if (!dark_area_consistent(red, code_i.code, true, layout, px_per_m) ||
       !dark_area_consistent(green, code_j.code, false, layout, px_per_m)) {
@@ -224,11 +228,6 @@ PairOutcome Pipeline::measure_predicted(const ImageView& frame, const PredictedM
   const CeilingLayout& layout = config_.layout;
   MarkerFrame m = predicted.frame;
   RectangleEdges red_edges = measure_edges(frame, m, true, layout);
-  CodeReading code_i, code_j;
-  const PairOutcome read = read_codes(frame, m, red_edges, &code_i, &code_j);
-  if (read != PairOutcome::kDecoded) return read;
-  if (code_i.code != predicted.code_i || code_j.code != predicted.code_j)
-    return PairOutcome::kInconsistent;
   RectangleEdges green_edges = measure_edges(frame, m, false, layout);
   // A profile measures its edge truly only near its middle: one that
   // crosses it off-centre takes part of the blurred rise (or a dot) for a
@@ -251,6 +250,16 @@ PairOutcome Pipeline::measure_predicted(const ImageView& frame, const PredictedM
         std::hypot(du, dv) > kRecentreEdges_px)
       return PairOutcome::kInconsistent;
   }
+  // The dots are then where the edges put them, to a pixel: their darkest
+  // line is sought over kTrackedDotSearch_m, not a whole sweep's
+  // dot_search_m (which allows for a frame fitted to blurred centroids).
+  CodeReading code_i, code_j;
+  const PairOutcome read =
+      read_codes(frame, m, red_edges, std::min(config_.detector.dot_search_m, kTrackedDotSearch_m),
+                 &code_i, &code_j);
+  if (read != PairOutcome::kDecoded) return read;
+  if (code_i.code != predicted.code_i || code_j.code != predicted.code_j)
+    return PairOutcome::kInconsistent;
   MarkerObservation& o = *out;
   o.code_i = code_i.code;
   o.code_j = code_j.code;
