@@ -108,6 +108,8 @@ class LsqSolver {
                          std::span<const bool> use, int marker_count) const;
   bool edge_points_in_use(std::span<const bool> use) const;
   bool reweigh_edges(const ViewGeometry& view, Fit* fit) const;
+  double free_tilt_gain_chi2(const ViewGeometry& view, const PositioningParams& params,
+                             const Fit& held) const;
   double position_sigma_m(const LsqModel& model, const LsqNormal& a, double wr2, int n) const;
   double rms_px(const ViewGeometry& view, std::span<const bool> use, const LsqState& st,
                 int n) const;
