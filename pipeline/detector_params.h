@@ -136,7 +136,7 @@ struct DetectorParams {
   // (no classification, no components: the rectangles' centroids are not
   // measured, and their dark-area check not made); false: the labeler sweeps
   // windows around them (docs/pipeline_speed.md has both).
-  bool track_edges = true;
+  bool track_edges = false;
   int full_sweep_every = 30;
   // Window margin around a marker's predicted outline: this many pixels...
   float track_margin_px = 4.0f;
