@@ -116,16 +116,24 @@ namespace {
 // The rectangles' edges around the marker as its points for positioning:
 // what lets a fit tell a tilt from a shift marker by marker
 // (rectangle_ends.h). Each is measured across its edge only.
+// Calls fn with every edge crossing found on both rectangles: ends, then
+// long sides, red first.
+template <typename Fn>
+void for_each_crossing(const RectangleEdges& red_edges, const RectangleEdges& green_edges, Fn fn) {
+  for (const RectangleEdges* edges : {&red_edges, &green_edges}) {
+    for (const EdgeCrossing& c : edges->end)
+      if (c.found) fn(c);
+    for (int k = 0; k < edges->side_count; ++k)
+      if (edges->side[static_cast<size_t>(k)].found) fn(edges->side[static_cast<size_t>(k)]);
+  }
+}
+
 void add_edge_points(const RectangleEdges& red_edges, const RectangleEdges& green_edges,
                      MarkerObservation* o) {
-  auto add_edge = [&](const EdgeCrossing& c) {
-    if (!c.found || o->point_count == kMaxPointsPerMarker) return;
+  for_each_crossing(red_edges, green_edges, [&](const EdgeCrossing& c) {
+    if (o->point_count == kMaxPointsPerMarker) return;
     o->points[o->point_count++] = {c.e_m, c.n_m, c.u_px, c.v_px, c.normal_u, c.normal_v};
-  };
-  for (const RectangleEdges* edges : {&red_edges, &green_edges}) {
-    for (const EdgeCrossing& c : edges->end) add_edge(c);
-    for (int k = 0; k < edges->side_count; ++k) add_edge(edges->side[static_cast<size_t>(k)]);
-  }
+  });
 }
 
 // How far the rectangles' edges lie from where `m` put them, as one image
@@ -135,8 +143,7 @@ void add_edge_points(const RectangleEdges& red_edges, const RectangleEdges& gree
 bool edge_shift_px(const MarkerFrame& m, const RectangleEdges& red_edges,
                    const RectangleEdges& green_edges, double* du, double* dv) {
   double a00 = 0.0, a01 = 0.0, a11 = 0.0, b0 = 0.0, b1 = 0.0;
-  auto add = [&](const EdgeCrossing& c) {
-    if (!c.found) return;
+  for_each_crossing(red_edges, green_edges, [&](const EdgeCrossing& c) {
     double u = 0.0, v = 0.0;
     m.project(c.e_m, c.n_m, &u, &v);
     const double d = (c.u_px - u) * c.normal_u + (c.v_px - v) * c.normal_v;
@@ -145,11 +152,7 @@ bool edge_shift_px(const MarkerFrame& m, const RectangleEdges& red_edges,
     a11 += c.normal_v * c.normal_v;
     b0 += c.normal_u * d;
     b1 += c.normal_v * d;
-  };
-  for (const RectangleEdges* edges : {&red_edges, &green_edges}) {
-    for (const EdgeCrossing& c : edges->end) add(c);
-    for (int k = 0; k < edges->side_count; ++k) add(edges->side[static_cast<size_t>(k)]);
-  }
+  });
   const double det = a00 * a11 - a01 * a01;
   if (!(det > 0.25)) return false;  // e.g. the ends alone: nothing across the long sides
   *du = (a11 * b0 - a01 * b1) / det;
