@@ -86,6 +86,30 @@ inline uint8_t pixel_darkest(const ImageView& f, int x, int y) {
   }
 }
 
+// Which channel a rectangle's edge is measured in (pipeline/rectangle_ends.h):
+// the one it prints dark in, the same on both sides of the edge.
+enum class EdgeChannel : uint8_t { kRed, kGreen };
+
+// That channel's level at pixel (x, y) of a frame in format F (not MJPEG).
+// YUV formats give their luma instead, full range: their chroma has half the
+// resolution, which would blur and shift an edge. Grey gives its level.
+template <PixelFormat F>
+inline uint8_t pixel_edge_level(const ImageView& f, int x, int y, EdgeChannel channel) {
+  const uint8_t* p = f.row(y);
+  const int rgb_offset = channel == EdgeChannel::kRed ? 0 : 1;
+  if constexpr (F == PixelFormat::kRgb24) {
+    return p[3 * x + rgb_offset];
+  } else if constexpr (F == PixelFormat::kBgr24) {
+    return p[3 * x + 2 - rgb_offset];
+  } else if constexpr (F == PixelFormat::kYuyv) {
+    return yuv_channel(yuv_luma_part(p[2 * x]), 0);
+  } else if constexpr (F == PixelFormat::kNv12 || F == PixelFormat::kYuv420) {
+    return yuv_channel(yuv_luma_part(p[x]), 0);
+  } else {
+    return p[x];
+  }
+}
+
 // Calls fn(std::integral_constant<PixelFormat, F>) for the frame's format F;
 // false for MJPEG (no pixels to read). One dispatch for a caller's many
 // reads.
@@ -138,6 +162,16 @@ inline void read_rgb_2x2(const ImageView& f, int x, int y, std::array<Rgb, 4>* o
   out->fill(Rgb{0, 0, 0});
   with_pixel_reader(f.format, [&](auto read) {
     for (int k = 0; k < 4; ++k) (*out)[k] = read(f, x + (k & 1), y + (k >> 1));
+  });
+}
+
+// The same four pixels' pixel_edge_level; 0 for MJPEG.
+inline void read_edge_level_2x2(const ImageView& f, int x, int y, EdgeChannel channel,
+                                std::array<uint8_t, 4>* out) {
+  out->fill(0);
+  with_pixel_format(f.format, [&](auto tag) {
+    for (int k = 0; k < 4; ++k)
+      (*out)[k] = pixel_edge_level<decltype(tag)::value>(f, x + (k & 1), y + (k >> 1), channel);
   });
 }
 

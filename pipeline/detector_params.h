@@ -132,11 +132,13 @@ struct DetectorParams {
   // fps; 1 = never track). Markers entering the view need no full sweep:
   // every marker of the map the view can hold gets a window.
   bool tracking = true;
-  // A tracked frame measured at the predicted markers' edges and dots alone
-  // (no classification, no components: the rectangles' centroids are not
-  // measured, and their dark-area check not made); false: the labeler sweeps
-  // windows around them (docs/pipeline_speed.md has both).
-  bool track_edges = false;
+  // A tracked frame measured at the predicted markers' edges (in linear
+  // light) and dots alone (no classification, no components: the
+  // rectangles' centroids are not measured, and their dark-area check not
+  // made); false: the labeler sweeps windows around them. Both are at
+  // least as accurate as a whole sweep on every scenario set; the edges
+  // cost about half (docs/pipeline_speed.md, docs/decisions.md).
+  bool track_edges = true;
   int full_sweep_every = 30;
   // Window margin around a marker's predicted outline: this many pixels...
   float track_margin_px = 4.0f;

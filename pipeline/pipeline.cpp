@@ -230,8 +230,8 @@ PairOutcome Pipeline::measure_predicted(const ImageView& frame, const PredictedM
                                         MarkerObservation* out) {
   const CeilingLayout& layout = config_.layout;
   MarkerFrame m = predicted.frame;
-  RectangleEdges red_edges = measure_edges(frame, m, true, layout);
-  RectangleEdges green_edges = measure_edges(frame, m, false, layout);
+  RectangleEdges red_edges = measure_edges(frame, m, true, layout, EdgeLevels::kLinearLight);
+  RectangleEdges green_edges = measure_edges(frame, m, false, layout, EdgeLevels::kLinearLight);
   // A profile measures its edge truly only near its middle: one that
   // crosses it off-centre takes part of the blurred rise (or a dot) for a
   // plateau. When the marker lies more than kRecentreEdges_px from its
@@ -247,8 +247,8 @@ PairOutcome Pipeline::measure_predicted(const ImageView& frame, const PredictedM
   if (std::hypot(du, dv) > kRecentreEdges_px) {
     m.centre_u_px += du;
     m.centre_v_px += dv;
-    red_edges = measure_edges(frame, m, true, layout);
-    green_edges = measure_edges(frame, m, false, layout);
+    red_edges = measure_edges(frame, m, true, layout, EdgeLevels::kLinearLight);
+    green_edges = measure_edges(frame, m, false, layout, EdgeLevels::kLinearLight);
     if (!edge_shift_px(m, red_edges, green_edges, &du, &dv) ||
         std::hypot(du, dv) > kRecentreEdges_px)
       return PairOutcome::kInconsistent;

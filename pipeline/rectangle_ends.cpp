@@ -9,32 +9,68 @@ namespace ceilpose {
 namespace {
 
 constexpr int kMaxSamples = 64;
-// Parallel profiles across one edge, averaged into one edge point: two,
-// either side of the point (a third in the middle cost 30 µs a frame and
-// bought nothing measurable).
-constexpr int kProfiles = 2;
+// Parallel profiles across one edge, averaged into one edge point, at these
+// fractions of the offset either side of it. Darkest levels: two (a third
+// in the middle cost 30 µs a frame and bought nothing measurable: the
+// levels' phase errors, below, outweighed the noise). Linear light: four,
+// which halve the noise of an edge-tracked frame, whose edges alone position
+// it (unseen drive, 25 ms readout: tracked frames' sd 0.034 → 0.024 mm).
+constexpr std::array<double, 2> kTwoProfiles{-1.0, 1.0};
+constexpr std::array<double, 4> kFourProfiles{-1.0, -1.0 / 3.0, 1.0 / 3.0, 1.0};
 // Their distance from the point along an end (1 in inside the long edges;
 // the rail along the shared edge is 0.5 in wide) and along a long side
 // (clear of the dots of the slots either side: a green dot reaches 1 in from
 // its slot).
 constexpr double kEndProfileOffset_m = 1.5 * kInch_m;
 constexpr double kSideProfileOffset_m = 0.6 * kInch_m;
-// Below this rise from rectangle to tile (darkest channel, 0–255) an edge is
+// Below this rise from rectangle to tile (the profile's levels, 0–255) an edge is
 // not measured: the tile is not what lies beyond it.
 constexpr double kMinContrast = 30.0;
-// A tile at or above this level (darkest channel) is clipped.
+// A tile at or above this level is clipped.
 constexpr double kClipLevel = 250.0;
 
-// The darkest channel at an image point, bilinear; negative outside the
-// frame. Red and green print far below the tile in it.
-double darkest_at(const ImageView& frame, double u, double v) {
+// Linear light (0–1) of an sRGB-encoded level, as cameras encode it.
+const std::array<float, 256>& linear_of_level() {
+  static const std::array<float, 256> table = [] {
+    std::array<float, 256> t{};
+    for (size_t i = 0; i < t.size(); ++i) {
+      const double c = static_cast<double>(i) / 255.0;
+      t[i] = static_cast<float>(c <= 0.04045 ? c / 12.92 : std::pow((c + 0.055) / 1.055, 2.4));
+    }
+    return t;
+  }();
+  return table;
+}
+
+// One sample of a profile, bilinear: the level (0–255) its contrast and
+// blur are judged on (the darkest channel's under kDarkestLevel, red and
+// green printing far below the tile in it; the edge channel's under
+// kLinearLight) and what the edge is measured in (that level, or its
+// linear light).
+struct Sample {
+  double level = 0.0, edge = 0.0;
+};
+
+// False outside the frame.
+bool sample_at(const ImageView& frame, double u, double v, EdgeLevels levels, EdgeChannel channel,
+               Sample* out) {
   const int x0 = static_cast<int>(std::floor(u)), y0 = static_cast<int>(std::floor(v));
-  if (x0 < 0 || y0 < 0 || x0 + 1 >= frame.width || y0 + 1 >= frame.height) return -1.0;
+  if (x0 < 0 || y0 < 0 || x0 + 1 >= frame.width || y0 + 1 >= frame.height) return false;
   const double fu = u - x0, fv = v - y0;
+  auto bilinear = [&](double c0, double c1, double c2, double c3) {
+    return (1 - fv) * ((1 - fu) * c0 + fu * c1) + fv * ((1 - fu) * c2 + fu * c3);
+  };
   std::array<uint8_t, 4> corner;
-  read_darkest_2x2(frame, x0, y0, &corner);
-  return (1 - fv) * ((1 - fu) * corner[0] + fu * corner[1]) +
-         fv * ((1 - fu) * corner[2] + fu * corner[3]);
+  if (levels == EdgeLevels::kDarkestLevel) {
+    read_darkest_2x2(frame, x0, y0, &corner);
+    out->level = out->edge = bilinear(corner[0], corner[1], corner[2], corner[3]);
+    return true;
+  }
+  read_edge_level_2x2(frame, x0, y0, channel, &corner);
+  const auto& lin = linear_of_level();
+  out->level = bilinear(corner[0], corner[1], corner[2], corner[3]);
+  out->edge = bilinear(lin[corner[0]], lin[corner[1]], lin[corner[2]], lin[corner[3]]);
+  return true;
 }
 
 // Where the level crosses 25 % and 75 % of the way from rectangle to tile,
@@ -44,19 +80,59 @@ struct Crossings {
   double at25 = NAN, at75 = NAN, at_edge = NAN;
 };
 
+// How a profile samples: `samples` steps of `step_m` centred on the edge,
+// half_m from it to either end.
+struct ProfileSteps {
+  double step_m = 0.0;
+  int samples = 0;
+  double half_m = 0.0;
+};
+
+// Darkest levels: `samples` spread over exactly ±kEdgeProfileHalf_m.
+ProfileSteps fitted_steps(int samples) {
+  return {2.0 * kEdgeProfileHalf_m / (samples - 1), samples, kEdgeProfileHalf_m};
+}
+
+// Linear light: a step that moves exactly one pixel along the image axis the
+// profile (marker direction (de, dn)) runs closest to, as many as fit in
+// ±kEdgeProfileHalf_m. The edge is the integral of the bilinear
+// interpolant, which bends at every pixel line; whole-pixel steps meet the
+// bends at one phase, so the sum is exact for an axis-aligned edge and
+// within ~0.008 px at any angle (steps fitted to the profile's length,
+// ~1.08 px, erred up to 0.03 px with the edge's phase). Zero samples: the
+// marker frame has no scale.
+ProfileSteps axis_steps(const MarkerFrame& marker, double de, double dn) {
+  const double du_per_m = de * marker.east_u + dn * marker.north_u;
+  const double dv_per_m = de * marker.east_v + dn * marker.north_v;
+  const double axis_px_per_m = std::max(std::abs(du_per_m), std::abs(dv_per_m));
+  ProfileSteps out;
+  if (!(axis_px_per_m > 0.0)) return out;
+  out.step_m = 1.0 / axis_px_per_m;
+  out.samples =
+      std::clamp(static_cast<int>(2.0 * kEdgeProfileHalf_m / out.step_m) + 1, 5, kMaxSamples);
+  out.half_m = 0.5 * (out.samples - 1) * out.step_m;
+  return out;
+}
+
 // One profile through marker point (e_m, n_m) on the edge along the unit
-// marker-frame direction (de, dn), pointing out of the rectangle, a sample
-// per pixel. False when it leaves the frame or the contrast is too low.
+// marker-frame direction (de, dn), pointing out of the rectangle. False when
+// it leaves the frame or the contrast is too low.
 bool profile(const ImageView& frame, const MarkerFrame& marker, double e_m, double n_m, double de,
-             double dn, int samples, Crossings* out) {
-  const double step_m = 2.0 * kEdgeProfileHalf_m / (samples - 1);
-  std::array<double, kMaxSamples> level;  // samples of them written before any is read
+             double dn, const ProfileSteps& steps, EdgeLevels levels, EdgeChannel channel,
+             Crossings* out) {
+  const int samples = steps.samples;
+  const double step_m = steps.step_m;
+  // Levels (contrast, blur) and what the edge is measured in; samples of
+  // them written before any is read.
+  std::array<double, kMaxSamples> level, edge;
   for (int k = 0; k < samples; ++k) {
-    const double s_m = -kEdgeProfileHalf_m + k * step_m;
+    const double s_m = -steps.half_m + k * step_m;
     double u = 0.0, v = 0.0;
     marker.project(e_m + s_m * de, n_m + s_m * dn, &u, &v);
-    level[k] = darkest_at(frame, u, v);
-    if (level[k] < 0.0) return false;
+    Sample sample;
+    if (!sample_at(frame, u, v, levels, channel, &sample)) return false;
+    level[k] = sample.level;
+    edge[k] = sample.edge;
   }
   const double low = 0.5 * (level[0] + level[1]);
   const double high = 0.5 * (level[samples - 1] + level[samples - 2]);
@@ -65,7 +141,7 @@ bool profile(const ImageView& frame, const MarkerFrame& marker, double e_m, doub
     const double target = low + fraction * (high - low);
     for (int k = 1; k < samples; ++k) {
       if (level[k] >= target && level[k - 1] < target)
-        return -kEdgeProfileHalf_m +
+        return -steps.half_m +
                ((k - 1) + (target - level[k - 1]) / (level[k] - level[k - 1])) * step_m;
     }
     return static_cast<double>(NAN);
@@ -81,31 +157,45 @@ bool profile(const ImageView& frame, const MarkerFrame& marker, double e_m, doub
   // shift varies with the edge's angle (a level frame of a +1.9 EV
   // render chose a tilt and was 2.8 mm off).
   if (std::isnan(crossing(0.5)) || high >= kClipLevel) return true;
+  // Under kLinearLight the area is summed in linear light: a pixel
+  // straddling the edge holds the area-weighted mean of the two sides'
+  // light, which its sRGB level does not (half covered, it reads ~70 % of
+  // the way up), so on levels the edge moves with its phase against the
+  // pixel grid: ±0.07–0.15 px on the simulator's axis-aligned edges, which
+  // no common edge offset absorbs. Nor in the darkest channel: across the
+  // edge it switches channel (the tile's darkest is blue, the red
+  // rectangle's green), which bends the rise. Whole sweeps keep the darkest
+  // levels (docs/decisions.md "Edges in linear light").
+  const double edge_low = 0.5 * (edge[0] + edge[1]);
+  const double edge_high = 0.5 * (edge[samples - 1] + edge[samples - 2]);
   double shortfall_m = 0.0;
   for (int k = 0; k < samples; ++k) {
-    const double rise = std::clamp((level[k] - low) / (high - low), 0.0, 1.0);
+    const double rise = std::clamp((edge[k] - edge_low) / (edge_high - edge_low), 0.0, 1.0);
     shortfall_m += (k == 0 || k == samples - 1 ? 0.5 : 1.0) * (1.0 - rise) * step_m;
   }
-  out->at_edge = -kEdgeProfileHalf_m + shortfall_m;
+  out->at_edge = -steps.half_m + shortfall_m;
   return true;
 }
 
 // The edge point of the edge through (e_m, n_m) with outward direction
-// (de, dn), from kProfiles parallel profiles `offset_m` either side of it;
+// (de, dn), from parallel profiles at `fractions` of `offset_m` along it;
 // *spread_m: their mean 25–75 % distance (NaN: not measured).
+template <size_t N>
 EdgeCrossing cross_edge(const ImageView& frame, const MarkerFrame& marker, double e_m, double n_m,
-                        double de, double dn, double offset_m, int samples, double* spread_m) {
+                        double de, double dn, double offset_m,
+                        const std::array<double, N>& fractions, const ProfileSteps& steps,
+                        EdgeLevels levels, EdgeChannel channel, double* spread_m) {
   EdgeCrossing out;
   double spread_sum_m = 0.0;
   int spreads = 0;
   double e_sum = 0.0, n_sum = 0.0, u_sum = 0.0, v_sum = 0.0;
   int found = 0;
-  for (int p = 0; p < kProfiles; ++p) {
+  for (double fraction : fractions) {
     // Along the edge is (−dn, de).
-    const double along_m = (p == 0 ? -1.0 : 1.0) * offset_m;
+    const double along_m = fraction * offset_m;
     const double pe = e_m - along_m * dn, pn = n_m + along_m * de;
     Crossings c;
-    if (!profile(frame, marker, pe, pn, de, dn, samples, &c)) continue;
+    if (!profile(frame, marker, pe, pn, de, dn, steps, levels, channel, &c)) continue;
     if (!std::isnan(c.at25) && !std::isnan(c.at75)) {
       spread_sum_m += c.at75 - c.at25;
       ++spreads;
@@ -122,7 +212,7 @@ EdgeCrossing cross_edge(const ImageView& frame, const MarkerFrame& marker, doubl
   *spread_m = spreads > 0 ? spread_sum_m / spreads : NAN;
   // An edge crossed by fewer than all profiles is partly hidden, dirty or
   // out of the frame: its mean would lean towards the part that was seen.
-  if (found < kProfiles) return out;
+  if (found < static_cast<int>(N)) return out;
   out.found = true;
   out.e_m = e_sum / found;
   out.n_m = n_sum / found;
@@ -136,12 +226,30 @@ EdgeCrossing cross_edge(const ImageView& frame, const MarkerFrame& marker, doubl
   return out;
 }
 
+// One edge under `levels`: two profiles over fitted steps, or four over
+// axis steps.
+EdgeCrossing measure_edge(const ImageView& frame, const MarkerFrame& marker, double e_m, double n_m,
+                          double de, double dn, double offset_m, int fitted_samples,
+                          EdgeLevels levels, EdgeChannel channel, double* spread_m) {
+  if (levels == EdgeLevels::kDarkestLevel)
+    return cross_edge(frame, marker, e_m, n_m, de, dn, offset_m, kTwoProfiles,
+                      fitted_steps(fitted_samples), levels, channel, spread_m);
+  const ProfileSteps steps = axis_steps(marker, de, dn);
+  if (steps.samples == 0) {
+    *spread_m = NAN;
+    return {};
+  }
+  return cross_edge(frame, marker, e_m, n_m, de, dn, offset_m, kFourProfiles, steps, levels,
+                    channel, spread_m);
+}
+
 }  // namespace
 
 RectangleEdges measure_edges(const ImageView& frame, const MarkerFrame& marker, bool red,
-                             const CeilingLayout& layout) {
+                             const CeilingLayout& layout, EdgeLevels levels) {
   RectangleEdges out;
   const double centre_e_m = red ? layout.red_centre_e_m() : layout.green_centre_e_m();
+  const EdgeChannel channel = red ? EdgeChannel::kGreen : EdgeChannel::kRed;
   const double px_per_m = std::hypot(marker.north_u, marker.north_v);
   if (!(px_per_m > 0.0)) return out;
   const int samples =
@@ -152,8 +260,8 @@ RectangleEdges measure_edges(const ImageView& frame, const MarkerFrame& marker, 
     const double dn = s == 0 ? 1.0 : -1.0;
     double spread_m = NAN;
     out.end[static_cast<size_t>(s)] =
-        cross_edge(frame, marker, centre_e_m, dn * 0.5 * layout.rect_height_m, 0.0, dn,
-                   kEndProfileOffset_m, samples, &spread_m);
+        measure_edge(frame, marker, centre_e_m, dn * 0.5 * layout.rect_height_m, 0.0, dn,
+                     kEndProfileOffset_m, samples, levels, channel, &spread_m);
     if (std::isnan(spread_m)) continue;
     spread_sum_m += spread_m;
     ++spreads;
@@ -164,8 +272,8 @@ RectangleEdges measure_edges(const ImageView& frame, const MarkerFrame& marker, 
   for (int k = 0; k + 1 < layout.bits && out.side_count < kMaxSideCrossings; ++k) {
     const double n_m = 0.5 * (layout.slot_n_m(k) + layout.slot_n_m(k + 1));
     double spread_m = NAN;
-    const EdgeCrossing c = cross_edge(frame, marker, de * layout.rect_width_m, n_m, de, 0.0,
-                                      kSideProfileOffset_m, samples, &spread_m);
+    const EdgeCrossing c = measure_edge(frame, marker, de * layout.rect_width_m, n_m, de, 0.0,
+                                        kSideProfileOffset_m, samples, levels, channel, &spread_m);
     if (c.found) out.side[static_cast<size_t>(out.side_count++)] = c;
   }
   return out;

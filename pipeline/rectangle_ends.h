@@ -46,10 +46,25 @@ struct RectangleEdges {
   double spread_px = -1.0;
 };
 
+// What an edge's position is measured in.
+enum class EdgeLevels {
+  // The darkest channel's 8-bit levels, two profiles an edge: what a whole
+  // sweep's fit weighs against the rectangles' centroids (and was tuned with).
+  kDarkestLevel,
+  // Linear light of one channel the rectangle prints dark in, the same on both
+  // sides of the edge (green for red, red for green; luma in YUV, whose
+  // chroma has half the resolution), four profiles an edge, a sample per
+  // pixel along the image axis the profile runs closest to: what an
+  // edge-tracked frame positions with alone. docs/decisions.md "Edges in
+  // linear light".
+  kLinearLight,
+};
+
 // The edges of the red (x code) or green (y code) rectangle of `marker`.
 // Sparse reads of the frame: no allocation.
 RectangleEdges measure_edges(const ImageView& frame, const MarkerFrame& marker, bool red,
-                             const CeilingLayout& layout);
+                             const CeilingLayout& layout,
+                             EdgeLevels levels = EdgeLevels::kDarkestLevel);
 
 // Blur along North at the rectangle's two short ends, in pixels
 // (measure_edges().spread_px): 0.5 px for a sharp edge, 1.35 σ for
