@@ -1,7 +1,7 @@
-// read_rgb_2x2 and read_darkest_2x2, the bilinear samples' readers (dot
-// slots, rectangle edges), give each of their four pixels exactly as read_rgb
-// does, in every format: random bytes, every position, odd and even columns
-// and rows.
+// read_rgb_2x2, read_darkest_2x2 and read_edge_level_2x2, the bilinear
+// samples' readers (dot slots, rectangle edges), give each of their four
+// pixels exactly as read_rgb does, in every format: random bytes, every position, odd and even
+// columns and rows.
 #include "core/pixel_read.h"
 
 #include <gtest/gtest.h>
@@ -71,6 +71,32 @@ TEST(PixelRead, TwoByTwoDarkestIsTheLeastChannelOfReadRgbInEveryFormat) {
       EXPECT_EQ(block[k], std::min({r, g, b})) << where << " pixel " << k;
     }
   });
+}
+
+// read_edge_level_2x2: RGB and BGR give the asked channel of read_rgb, grey
+// its level, and YUV formats their luma byte in full range (the level a
+// Y of 16 / 235 stands for: 0 / 255), whatever the chroma.
+TEST(PixelRead, TwoByTwoEdgeLevelsAreTheChannelOrTheLumaInEveryFormat) {
+  for_every_block(13, [](const ImageView& view, int x, int y, const std::string& where) {
+    for (EdgeChannel channel : {EdgeChannel::kRed, EdgeChannel::kGreen}) {
+      std::array<uint8_t, 4> block;
+      read_edge_level_2x2(view, x, y, channel, &block);
+      for (int k = 0; k < 4; ++k) {
+        const int px = x + (k & 1), py = y + (k >> 1);
+        uint8_t r = 0, g = 0, b = 0;
+        read_rgb(view, px, py, &r, &g, &b);
+        uint8_t expected = channel == EdgeChannel::kRed ? r : g;
+        if (view.format == PixelFormat::kYuyv) {
+          expected = yuv_channel(yuv_luma_part(view.row(py)[2 * px]), 0);
+        } else if (is_yuv420(view.format)) {
+          expected = yuv_channel(yuv_luma_part(view.row(py)[px]), 0);
+        }
+        EXPECT_EQ(block[k], expected) << where << " pixel " << k;
+      }
+    }
+  });
+  EXPECT_EQ(yuv_channel(yuv_luma_part(16), 0), 0);
+  EXPECT_EQ(yuv_channel(yuv_luma_part(235), 0), 255);
 }
 
 }  // namespace
