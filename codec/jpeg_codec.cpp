@@ -57,7 +57,8 @@ Result<JpegHeader> JpegCodec::header(const uint8_t* data, size_t size) {
                           &colourspace) != 0) {
     return make_error("corrupt JPEG data (" + library_error(decompressor_) + ")");
   }
-  return JpegHeader{width, height, colourspace == TJCS_GRAY};
+  const bool grey = colourspace == TJCS_GRAY;
+  return JpegHeader{width, height, grey, !grey && subsampling != TJSAMP_444};
 }
 
 Result<void> JpegCodec::decode(const uint8_t* data, size_t size, PixelFormat format, Image* out,
@@ -104,6 +105,7 @@ Result<void> JpegCodec::decode_to(const uint8_t* data, size_t size, const JpegHe
                     TJFLAG_STOPONWARNING) != 0) {
     return make_error("corrupt JPEG data (" + library_error(decompressor_) + ")");
   }
+  out->set_chroma_halved(header.chroma_halved);
   return {};
 }
 

@@ -15,6 +15,9 @@ struct JpegHeader {
   int width = 0;
   int height = 0;
   bool grey = false;  // one component
+  // Colour with chroma at half the resolution (4:2:0, 4:2:2, 4:4:0, 4:1:1):
+  // what it decodes to is marked ImageView::chroma_halved.
+  bool chroma_halved = false;
 };
 
 // One per thread: it holds the library's handles, so once the frame size

@@ -58,6 +58,10 @@ struct ImageView {
   int stride_bytes = 0;
   PixelFormat format = PixelFormat::kRgb24;
   size_t size_bytes = 0;  // for compressed formats: the payload length
+  // RGB decoded from data whose chroma had half the resolution (a 4:2:0 or
+  // 4:2:2 JPEG, as MJPEG cameras send): its colour channels carry that
+  // chroma, blurred, and only a luma is sharp (pipeline/rectangle_ends.h).
+  bool chroma_halved = false;
 
   bool empty() const { return data == nullptr || width <= 0 || height <= 0; }
   const uint8_t* row(int y) const { return data + static_cast<ptrdiff_t>(y) * stride_bytes; }
@@ -86,7 +90,10 @@ class Image {
     format_ = format;
     stride_bytes_ = width * bytes_per_pixel(format);
     pixels_.resize(frame_bytes(format, stride_bytes_, height));
+    chroma_halved_ = false;
   }
+  // Set by whoever writes pixels decoded from subsampled chroma (ImageView).
+  void set_chroma_halved(bool halved) { chroma_halved_ = halved; }
   int width() const { return width_; }
   int height() const { return height_; }
   int stride_bytes() const { return stride_bytes_; }
@@ -96,7 +103,8 @@ class Image {
   uint8_t* row(int y) { return pixels_.data() + static_cast<size_t>(y) * stride_bytes_; }
   size_t size_bytes() const { return pixels_.size(); }
   ImageView view() const {
-    return ImageView{pixels_.data(), width_, height_, stride_bytes_, format_, pixels_.size()};
+    return ImageView{pixels_.data(), width_,         height_,       stride_bytes_,
+                     format_,        pixels_.size(), chroma_halved_};
   }
 
  private:
@@ -105,6 +113,7 @@ class Image {
   int height_ = 0;
   int stride_bytes_ = 0;
   PixelFormat format_ = PixelFormat::kRgb24;
+  bool chroma_halved_ = false;
 };
 
 }  // namespace ceilpose

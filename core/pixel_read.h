@@ -87,20 +87,28 @@ inline uint8_t pixel_darkest(const ImageView& f, int x, int y) {
 }
 
 // Which channel a rectangle's edge is measured in (pipeline/rectangle_ends.h):
-// the one it prints dark in, the same on both sides of the edge.
-enum class EdgeChannel : uint8_t { kRed, kGreen };
+// the one it prints dark in, the same on both sides of the edge; or the
+// luma, where the colour channels carry chroma at half the resolution.
+enum class EdgeChannel : uint8_t { kRed, kGreen, kLuma };
+
+// BT.601 luma of 8-bit R, G, B.
+inline uint8_t rgb_luma(int r, int g, int b) {
+  return static_cast<uint8_t>((77 * r + 150 * g + 29 * b + 128) >> 8);
+}
 
 // That channel's level at pixel (x, y) of a frame in format F (not MJPEG).
-// YUV formats give their luma instead, full range: their chroma has half the
+// YUV formats always give their luma, full range: their chroma has half the
 // resolution, which would blur and shift an edge. Grey gives its level.
 template <PixelFormat F>
 inline uint8_t pixel_edge_level(const ImageView& f, int x, int y, EdgeChannel channel) {
   const uint8_t* p = f.row(y);
   const int rgb_offset = channel == EdgeChannel::kRed ? 0 : 1;
   if constexpr (F == PixelFormat::kRgb24) {
-    return p[3 * x + rgb_offset];
+    const uint8_t* q = p + 3 * x;
+    return channel == EdgeChannel::kLuma ? rgb_luma(q[0], q[1], q[2]) : q[rgb_offset];
   } else if constexpr (F == PixelFormat::kBgr24) {
-    return p[3 * x + 2 - rgb_offset];
+    const uint8_t* q = p + 3 * x;
+    return channel == EdgeChannel::kLuma ? rgb_luma(q[2], q[1], q[0]) : q[2 - rgb_offset];
   } else if constexpr (F == PixelFormat::kYuyv) {
     return yuv_channel(yuv_luma_part(p[2 * x]), 0);
   } else if constexpr (F == PixelFormat::kNv12 || F == PixelFormat::kYuv420) {

@@ -249,7 +249,9 @@ RectangleEdges measure_edges(const ImageView& frame, const MarkerFrame& marker, 
                              const CeilingLayout& layout, EdgeLevels levels) {
   RectangleEdges out;
   const double centre_e_m = red ? layout.red_centre_e_m() : layout.green_centre_e_m();
-  const EdgeChannel channel = red ? EdgeChannel::kGreen : EdgeChannel::kRed;
+  const EdgeChannel channel = frame.chroma_halved ? EdgeChannel::kLuma
+                              : red               ? EdgeChannel::kGreen
+                                                  : EdgeChannel::kRed;
   const double px_per_m = std::hypot(marker.north_u, marker.north_v);
   if (!(px_per_m > 0.0)) return out;
   const int samples =

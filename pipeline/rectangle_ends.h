@@ -52,8 +52,9 @@ enum class EdgeLevels {
   // sweep's fit weighs against the rectangles' centroids (and was tuned with).
   kDarkestLevel,
   // Linear light of one channel the rectangle prints dark in, the same on both
-  // sides of the edge (green for red, red for green; luma in YUV, whose
-  // chroma has half the resolution), four profiles an edge, a sample per
+  // sides of the edge (green for red, red for green; luma in YUV and in RGB
+  // decoded from a subsampled JPEG, ImageView::chroma_halved, whose chroma
+  // has half the resolution), four profiles an edge, a sample per
   // pixel along the image axis the profile runs closest to: what an
   // edge-tracked frame positions with alone. docs/decisions.md "Edges in
   // linear light".

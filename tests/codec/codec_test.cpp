@@ -135,6 +135,28 @@ TEST(JpegCodec, EncodesWhatOpenCvDecodesCloseToTheSource) {
   }
 }
 
+// What a subsampled JPEG decodes to is marked as such (its colour channels
+// carry half-resolution chroma: rectangle_ends measures edges in luma
+// there); a grey one, and an image resized for other pixels, are not.
+TEST(JpegCodec, DecodedSubsampledChromaIsMarkedOnTheImage) {
+  JpegCodec codec;
+  const Image src = test_image(64, 48, PixelFormat::kRgb24, 3);
+  std::vector<uint8_t> jpeg;
+  ASSERT_TRUE(codec.encode(src.view(), 90, &jpeg));  // 4:2:0, as cameras send
+  Image out;
+  ASSERT_TRUE(codec.decode(jpeg.data(), jpeg.size(), PixelFormat::kRgb24, &out));
+  EXPECT_TRUE(out.view().chroma_halved);
+  out.resize(64, 48, PixelFormat::kRgb24);
+  EXPECT_FALSE(out.view().chroma_halved);
+  // The same frame through decode_fixed (the V4L2 MJPEG path).
+  ASSERT_TRUE(codec.decode_fixed(jpeg.data(), jpeg.size(), &out));
+  EXPECT_TRUE(out.view().chroma_halved);
+  const Image grey = test_image(64, 48, PixelFormat::kGray8, 3);
+  ASSERT_TRUE(codec.encode(grey.view(), 90, &jpeg));
+  ASSERT_TRUE(codec.decode(jpeg.data(), jpeg.size(), PixelFormat::kGray8, &out));
+  EXPECT_FALSE(out.view().chroma_halved);
+}
+
 TEST(JpegCodec, TruncatedOrCorruptStreamsAreErrorsNotGreyPictures) {
   JpegCodec codec;
   const Image src = test_image(160, 120, PixelFormat::kRgb24, 3);

@@ -73,19 +73,21 @@ TEST(PixelRead, TwoByTwoDarkestIsTheLeastChannelOfReadRgbInEveryFormat) {
   });
 }
 
-// read_edge_level_2x2: RGB and BGR give the asked channel of read_rgb, grey
-// its level, and YUV formats their luma byte in full range (the level a
+// read_edge_level_2x2: RGB and BGR give the asked channel of read_rgb (or
+// its BT.601 luma), grey its level, and YUV formats their luma byte in full range (the level a
 // Y of 16 / 235 stands for: 0 / 255), whatever the chroma.
 TEST(PixelRead, TwoByTwoEdgeLevelsAreTheChannelOrTheLumaInEveryFormat) {
   for_every_block(13, [](const ImageView& view, int x, int y, const std::string& where) {
-    for (EdgeChannel channel : {EdgeChannel::kRed, EdgeChannel::kGreen}) {
+    for (EdgeChannel channel : {EdgeChannel::kRed, EdgeChannel::kGreen, EdgeChannel::kLuma}) {
       std::array<uint8_t, 4> block;
       read_edge_level_2x2(view, x, y, channel, &block);
       for (int k = 0; k < 4; ++k) {
         const int px = x + (k & 1), py = y + (k >> 1);
         uint8_t r = 0, g = 0, b = 0;
         read_rgb(view, px, py, &r, &g, &b);
-        uint8_t expected = channel == EdgeChannel::kRed ? r : g;
+        uint8_t expected = channel == EdgeChannel::kRed     ? r
+                           : channel == EdgeChannel::kGreen ? g
+                                                            : rgb_luma(r, g, b);
         if (view.format == PixelFormat::kYuyv) {
           expected = yuv_channel(yuv_luma_part(view.row(py)[2 * px]), 0);
         } else if (is_yuv420(view.format)) {
