@@ -42,34 +42,15 @@ const std::array<float, 256>& linear_of_level() {
   return table;
 }
 
-// One sample of a profile, bilinear: the level (0–255) its contrast and
-// blur are judged on (the darkest channel's under kDarkestLevel, red and
-// green printing far below the tile in it; the edge channel's under
-// kLinearLight) and what the edge is measured in (that level, or its
-// linear light).
-struct Sample {
-  double level = 0.0, edge = 0.0;
-};
-
-// False outside the frame.
-bool sample_at(const ImageView& frame, double u, double v, EdgeLevels levels, EdgeChannel channel,
-               Sample* out) {
+// The darkest channel's level (0–255) at (u, v), bilinear: red and green
+// print far below the tile in it. False outside the frame.
+bool darkest_at(const ImageView& frame, double u, double v, double* level) {
   const int x0 = static_cast<int>(std::floor(u)), y0 = static_cast<int>(std::floor(v));
   if (x0 < 0 || y0 < 0 || x0 + 1 >= frame.width || y0 + 1 >= frame.height) return false;
   const double fu = u - x0, fv = v - y0;
-  auto bilinear = [&](double c0, double c1, double c2, double c3) {
-    return (1 - fv) * ((1 - fu) * c0 + fu * c1) + fv * ((1 - fu) * c2 + fu * c3);
-  };
-  std::array<uint8_t, 4> corner;
-  if (levels == EdgeLevels::kDarkestLevel) {
-    read_darkest_2x2(frame, x0, y0, &corner);
-    out->level = out->edge = bilinear(corner[0], corner[1], corner[2], corner[3]);
-    return true;
-  }
-  read_edge_level_2x2(frame, x0, y0, channel, &corner);
-  const auto& lin = linear_of_level();
-  out->level = bilinear(corner[0], corner[1], corner[2], corner[3]);
-  out->edge = bilinear(lin[corner[0]], lin[corner[1]], lin[corner[2]], lin[corner[3]]);
+  std::array<uint8_t, 4> c;
+  read_darkest_2x2(frame, x0, y0, &c);
+  *level = (1 - fv) * ((1 - fu) * c[0] + fu * c[1]) + fv * ((1 - fu) * c[2] + fu * c[3]);
   return true;
 }
 
@@ -114,6 +95,60 @@ ProfileSteps axis_steps(const MarkerFrame& marker, double de, double dn) {
   return out;
 }
 
+// The levels of a kDarkestLevel profile, which its edge is measured in
+// too: bilinear samples over ±steps.half_m. False when one leaves the frame.
+bool read_fitted_profile(const ImageView& frame, const MarkerFrame& marker, double e_m, double n_m,
+                         double de, double dn, const ProfileSteps& steps, double* level) {
+  for (int k = 0; k < steps.samples; ++k) {
+    const double s_m = -steps.half_m + k * steps.step_m;
+    double u = 0.0, v = 0.0;
+    marker.project(e_m + s_m * de, n_m + s_m * dn, &u, &v);
+    if (!darkest_at(frame, u, v, &level[k])) return false;
+  }
+  return true;
+}
+
+// The same for a kLinearLight profile over axis_steps, and its linear
+// light. Each step moves one whole pixel along the dominant axis, so the
+// bilinear weights along it are the same for every sample: the profile is
+// stepped rather than projected, and its format dispatched once (a tracked
+// 640×480 frame's edges in ~half the time). False when a sample leaves the
+// frame.
+template <PixelFormat F>
+bool read_axis_profile(const ImageView& frame, const MarkerFrame& marker, double e_m, double n_m,
+                       double de, double dn, const ProfileSteps& steps, EdgeChannel channel,
+                       double* level, double* edge) {
+  const double du_per_m = de * marker.east_u + dn * marker.north_u;
+  const double dv_per_m = de * marker.east_v + dn * marker.north_v;
+  const bool u_major = std::abs(du_per_m) >= std::abs(dv_per_m);
+  double u = 0.0, v = 0.0;
+  marker.project(e_m - steps.half_m * de, n_m - steps.half_m * dn, &u, &v);
+  const double major = u_major ? u : v;
+  double minor = u_major ? v : u;
+  const double minor_step = (u_major ? dv_per_m : du_per_m) * steps.step_m;
+  const int major_step = (u_major ? du_per_m : dv_per_m) > 0.0 ? 1 : -1;
+  const int major_limit = u_major ? frame.width : frame.height;
+  const int minor_limit = u_major ? frame.height : frame.width;
+  int a = static_cast<int>(std::floor(major));
+  const double fa = major - a;
+  auto read = [&](int major_px, int minor_px) {
+    return u_major ? pixel_edge_level<F>(frame, major_px, minor_px, channel)
+                   : pixel_edge_level<F>(frame, minor_px, major_px, channel);
+  };
+  const auto& lin = linear_of_level();
+  for (int k = 0; k < steps.samples; ++k, a += major_step, minor += minor_step) {
+    const int b = static_cast<int>(std::floor(minor));
+    if (a < 0 || a + 1 >= major_limit || b < 0 || b + 1 >= minor_limit) return false;
+    const double fb = minor - b;
+    const uint8_t c00 = read(a, b), c10 = read(a + 1, b);
+    const uint8_t c01 = read(a, b + 1), c11 = read(a + 1, b + 1);
+    level[k] = (1 - fb) * ((1 - fa) * c00 + fa * c10) + fb * ((1 - fa) * c01 + fa * c11);
+    edge[k] = (1 - fb) * ((1 - fa) * lin[c00] + fa * lin[c10]) +
+              fb * ((1 - fa) * lin[c01] + fa * lin[c11]);
+  }
+  return true;
+}
+
 // One profile through marker point (e_m, n_m) on the edge along the unit
 // marker-frame direction (de, dn), pointing out of the rectangle. False when
 // it leaves the frame or the contrast is too low.
@@ -122,18 +157,20 @@ bool profile(const ImageView& frame, const MarkerFrame& marker, double e_m, doub
              Crossings* out) {
   const int samples = steps.samples;
   const double step_m = steps.step_m;
-  // Levels (contrast, blur) and what the edge is measured in; samples of
-  // them written before any is read.
+  // Levels (contrast, blur) and what the edge is measured in (the darkest
+  // level itself, or the channel's linear light).
   std::array<double, kMaxSamples> level, edge;
-  for (int k = 0; k < samples; ++k) {
-    const double s_m = -steps.half_m + k * step_m;
-    double u = 0.0, v = 0.0;
-    marker.project(e_m + s_m * de, n_m + s_m * dn, &u, &v);
-    Sample sample;
-    if (!sample_at(frame, u, v, levels, channel, &sample)) return false;
-    level[k] = sample.level;
-    edge[k] = sample.edge;
+  bool inside = false;
+  if (levels == EdgeLevels::kDarkestLevel) {
+    inside = read_fitted_profile(frame, marker, e_m, n_m, de, dn, steps, level.data());
+    edge = level;
+  } else {
+    with_pixel_format(frame.format, [&](auto tag) {
+      inside = read_axis_profile<decltype(tag)::value>(frame, marker, e_m, n_m, de, dn, steps,
+                                                       channel, level.data(), edge.data());
+    });
   }
+  if (!inside) return false;
   const double low = 0.5 * (level[0] + level[1]);
   const double high = 0.5 * (level[samples - 1] + level[samples - 2]);
   if (high - low < kMinContrast) return false;
