@@ -5,6 +5,7 @@
 #include <cmath>
 #include <numbers>
 
+#include "core/pixel_read.h"
 #include "pipeline/color_classifier.h"
 
 // Heading (SPEC §2–3). The red→green vector is the marker's West. Looking
@@ -84,7 +85,74 @@ Brightness line_brightness(const ImageView& frame, const MarkerFrame& m, double 
   return sum;
 }
 
+// The reference patches: half-way between slots (and beyond the end slots
+// while that stays 1 in inside the rectangle), each spread over ±a quarter
+// of the rectangle's width and ±kReferenceSpreadN of a dot's height.
+double reference_limit_n_m(const CeilingLayout& layout) {
+  return 0.5 * layout.rect_height_m - kInch_m;
+}
+double reference_spread_e_m(const CeilingLayout& layout) { return 0.25 * layout.rect_width_m; }
+constexpr double kReferenceSpreadN = 0.1;
+
 }  // namespace
+
+MarkerRegion::MarkerRegion(const MarkerFrame& marker, double e0_m, double e1_m, double n0_m,
+                           double n1_m, int width, int height)
+    : marker_(marker),
+      det_(marker.east_u * marker.north_v - marker.east_v * marker.north_u),
+      width_(width) {
+  const double px_per_m = std::hypot(marker.north_u, marker.north_v);
+  if (!(std::abs(det_) > 0.0) || !(px_per_m > 0.0) || !(e0_m <= e1_m) || !(n0_m <= n1_m)) return;
+  // A bilinear read at the rectangle's rim touches the pixel beyond it.
+  const double pad_m = 1.5 / px_per_m;
+  e0_m_ = e0_m - pad_m, e1_m_ = e1_m + pad_m, n0_m_ = n0_m - pad_m, n1_m_ = n1_m + pad_m;
+  double v_min = INFINITY, v_max = -INFINITY;
+  for (double e_m : {e0_m_, e1_m_}) {
+    for (double n_m : {n0_m_, n1_m_}) {
+      double u = 0.0, v = 0.0;
+      marker.project(e_m, n_m, &u, &v);
+      v_min = std::min(v_min, v);
+      v_max = std::max(v_max, v);
+    }
+  }
+  if (!std::isfinite(v_min) || !std::isfinite(v_max)) return;
+  first_row_ = static_cast<int>(std::max(0.0, std::floor(v_min)));
+  last_row_ = static_cast<int>(std::min(height - 1.0, std::ceil(v_max)));
+}
+
+PixelSpan MarkerRegion::row(int y) const {
+  // Along row y, e and n are affine in u: each bounds u to an interval.
+  const MarkerFrame& m = marker_;
+  const double dv = y - m.centre_v_px;
+  const double e_at_centre_m = -dv * m.north_u / det_, n_at_centre_m = dv * m.east_u / det_;
+  const double e_per_px = m.north_v / det_, n_per_px = -m.east_v / det_;
+  double du_lo = -INFINITY, du_hi = INFINITY;
+  auto bound = [&](double at_centre_m, double per_px, double lo_m, double hi_m) {
+    if (per_px == 0.0) {
+      if (at_centre_m < lo_m || at_centre_m > hi_m) du_lo = INFINITY;
+      return;
+    }
+    const double a = (lo_m - at_centre_m) / per_px, b = (hi_m - at_centre_m) / per_px;
+    du_lo = std::max(du_lo, std::min(a, b));
+    du_hi = std::min(du_hi, std::max(a, b));
+  };
+  bound(e_at_centre_m, e_per_px, e0_m_, e1_m_);
+  bound(n_at_centre_m, n_per_px, n0_m_, n1_m_);
+  PixelSpan out;
+  if (!(du_lo <= du_hi)) return out;
+  out.x0 = static_cast<int>(std::max(0.0, std::floor(m.centre_u_px + du_lo)));
+  out.x1 = static_cast<int>(std::min(width_ - 1.0, std::ceil(m.centre_u_px + du_hi)));
+  return out;
+}
+
+void ask_marker_region(const ImageView& frame, const MarkerFrame& marker, double e0_m, double e1_m,
+                       double n0_m, double n1_m) {
+  const MarkerRegion region(marker, e0_m, e1_m, n0_m, n1_m, frame.width, frame.height);
+  for (int y = region.first_row(); y <= region.last_row(); ++y) {
+    const PixelSpan span = region.row(y);
+    if (span.x0 <= span.x1) prefetch_pixels(frame, y, span.x0, span.x1);
+  }
+}
 
 MarkerFrame marker_frame(const RectangleCandidate& red, const RectangleCandidate& green,
                          const CeilingLayout& layout) {
@@ -127,16 +195,14 @@ CodeReading read_code(const ImageView& frame, const MarkerFrame& marker, bool re
   const double e_m = red ? layout.red_centre_e_m() : layout.green_centre_e_m();
   const double dot_e_m = red ? layout.red_dot_e_m : layout.green_dot_e_m;
   const double dot_n_m = red ? layout.red_dot_n_m : layout.green_dot_n_m;
-  // Reference: half-way between slots (and beyond the end slots while that
-  // stays 1 in inside the rectangle).
-  const double limit_n_m = 0.5 * layout.rect_height_m - kInch_m;
+  const double limit_n_m = reference_limit_n_m(layout);
   Brightness ref_sum{0.0, 0.0};
   int ref_count = 0;
   for (int k = 0; k <= layout.bits; ++k) {
     const double n_m = layout.slot_n_m(0) + 0.5 * layout.slot_pitch_m - k * layout.slot_pitch_m;
     if (std::abs(n_m) > limit_n_m) continue;
-    const Brightness b =
-        patch_brightness(frame, marker, e_m, n_m, 0.25 * layout.rect_width_m, 0.1 * dot_n_m);
+    const Brightness b = patch_brightness(frame, marker, e_m, n_m, reference_spread_e_m(layout),
+                                          kReferenceSpreadN * dot_n_m);
     if (b[0] < 0.0) return out;
     ref_sum[0] += b[0];
     ref_sum[1] += b[1];
@@ -176,6 +242,18 @@ CodeReading read_code(const ImageView& frame, const MarkerFrame& marker, bool re
   out.code = code;
   out.margin = static_cast<float>(margin);
   return out;
+}
+
+void ask_code(const ImageView& frame, const MarkerFrame& marker, bool red,
+              const CeilingLayout& layout, double search_m) {
+  const double e_m = red ? layout.red_centre_e_m() : layout.green_centre_e_m();
+  const double dot_n_m = red ? layout.red_dot_n_m : layout.green_dot_n_m;
+  // The reference patches reach furthest East–West, the dots' search
+  // furthest North–South (slot_n_m(0) is the northernmost slot).
+  const double half_e_m = reference_spread_e_m(layout);
+  const double half_n_m = std::max(reference_limit_n_m(layout) + kReferenceSpreadN * dot_n_m,
+                                   layout.slot_n_m(0) + search_m);
+  ask_marker_region(frame, marker, e_m - half_e_m, e_m + half_e_m, -half_n_m, half_n_m);
 }
 
 bool dark_area_consistent(const RectangleCandidate& rect, int code, bool red,

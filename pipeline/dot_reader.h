@@ -28,6 +28,35 @@ struct MarkerFrame {
 MarkerFrame marker_frame(const RectangleCandidate& red, const RectangleCandidate& green,
                          const CeilingLayout& layout);
 
+// The pixels of a width × height frame within marker-frame rectangle
+// e ∈ [e0_m, e1_m], n ∈ [n0_m, n1_m] and those a bilinear read inside it
+// touches beyond it: rows first_row..last_row, each the columns its row()
+// spans (x0 > x1: none).
+struct PixelSpan {
+  int x0 = 0, x1 = -1;
+};
+class MarkerRegion {
+ public:
+  MarkerRegion(const MarkerFrame& marker, double e0_m, double e1_m, double n0_m, double n1_m,
+               int width, int height);
+  int first_row() const { return first_row_; }
+  int last_row() const { return last_row_; }
+  PixelSpan row(int y) const;
+
+ private:
+  MarkerFrame marker_;
+  double e0_m_ = 0.0, e1_m_ = 0.0, n0_m_ = 0.0, n1_m_ = 0.0;
+  double det_ = 0.0;
+  int width_ = 0;
+  int first_row_ = 0, last_row_ = -1;
+};
+
+// Asks the memory system (a prefetch hint: no effect on results) for a
+// MarkerRegion's pixels of the frame: row by row, only the span the
+// rectangle's image crosses.
+void ask_marker_region(const ImageView& frame, const MarkerFrame& marker, double e0_m, double e1_m,
+                       double n0_m, double n1_m);
+
 struct CodeReading {
   bool ok = false;                      // every sample inside the frame and a usable reference
   int code = 0;                         // 0 .. 2^bits − 1
@@ -48,6 +77,11 @@ float dot_threshold_ratio(const DetectorParams& params, double blur_px, double r
 CodeReading read_code(const ImageView& frame, const MarkerFrame& marker, bool red,
                       const CeilingLayout& layout, const DetectorParams& params,
                       float threshold_ratio, double search_m = -1.0);
+
+// Asks the memory system for the pixels read_code(frame, marker, red,
+// layout, ..., search_m) reads (search_m ≥ 0).
+void ask_code(const ImageView& frame, const MarkerFrame& marker, bool red,
+              const CeilingLayout& layout, double search_m);
 
 // Whether the dark pixels found inside a rectangle fit the dots its code
 // says it has: more dark area than the dots plus slack means dirt, an

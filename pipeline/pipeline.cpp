@@ -21,6 +21,9 @@ constexpr double kRecentreEdges_px = 1.0;
 // How far along North an edge-tracked marker's dots are sought from their
 // slots (a whole sweep: detector.dot_search_m, 1 in).
 constexpr double kTrackedDotSearch_m = 0.25 * kInch_m;
+double tracked_dot_search_m(const DetectorParams& detector) {
+  return std::min(detector.dot_search_m, kTrackedDotSearch_m);
+}
 
 void check_size(const CameraIntrinsics& k) {
   if (k.width <= 0 || k.height <= 0) {
@@ -258,8 +261,7 @@ PairOutcome Pipeline::measure_predicted(const ImageView& frame, const PredictedM
   // dot_search_m (which allows for a frame fitted to blurred centroids).
   CodeReading code_i, code_j;
   const PairOutcome read =
-      read_codes(frame, m, red_edges, std::min(config_.detector.dot_search_m, kTrackedDotSearch_m),
-                 &code_i, &code_j);
+      read_codes(frame, m, red_edges, tracked_dot_search_m(config_.detector), &code_i, &code_j);
   if (read != PairOutcome::kDecoded) return read;
   if (code_i.code != predicted.code_i || code_j.code != predicted.code_j)
     return PairOutcome::kInconsistent;
@@ -399,19 +401,15 @@ void Pipeline::process_tracked(const ImageView& frame, PositioningMode mode, Fra
   StageClock clock(out);
   if (begin(frame, out) != Refusal::kNone) return clock.finish();
   // Nothing swept the frame: it is in memory, not in cache. Each marker's
-  // box is asked for one marker ahead of its reading (a tracked 640x480
-  // frame 16 % cheaper, docs/pipeline_speed.md).
-  const double reach_m = std::hypot(config_.layout.rect_width_m + kInch_m,
-                                    0.5 * config_.layout.rect_height_m + kInch_m);
+  // edge bands and dot rows are asked for one marker ahead of its reading
+  // (docs/pipeline_speed.md).
+  const double search_m = tracked_dot_search_m(config_.detector);
   auto ask = [&](size_t k) {
     if (k >= predicted.size()) return;
-    const MarkerFrame& m = predicted[k].frame;
-    const double r_px = reach_m * std::hypot(m.north_u, m.north_v) + 2.0;
-    const int x0 = std::max(0, static_cast<int>(m.centre_u_px - r_px));
-    const int x1 = std::min(frame.width - 1, static_cast<int>(m.centre_u_px + r_px));
-    const int y0 = std::max(0, static_cast<int>(m.centre_v_px - r_px));
-    const int y1 = std::min(frame.height - 1, static_cast<int>(m.centre_v_px + r_px));
-    for (int y = y0; y <= y1; ++y) prefetch_pixels(frame, y, x0, x1);
+    for (bool red : {true, false}) {
+      ask_edges(frame, predicted[k].frame, red, config_.layout);
+      ask_code(frame, predicted[k].frame, red, config_.layout, search_m);
+    }
   };
   ask(0);
   for (size_t k = 0; k < predicted.size(); ++k) {

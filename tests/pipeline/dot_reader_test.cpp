@@ -6,6 +6,7 @@
 #include <cmath>
 #include <cstdio>
 #include <numbers>
+#include <random>
 #include <vector>
 
 #include "pipeline/rectangle_ends.h"
@@ -244,6 +245,64 @@ TEST_F(DotReaderTest, DarkAreaBeyondTheCodesDotsIsInconsistent) {
   r.dark_px = 2.0 * red_dot_px;
   EXPECT_TRUE(dark_area_consistent(r, 3, true, layout, s));   // two dots: fits
   EXPECT_FALSE(dark_area_consistent(r, 0, true, layout, s));  // no dots: dirt
+}
+
+// What a tracked marker's pixels are asked for by (ask_marker_region): every
+// pixel a bilinear read inside the region touches lies in its row's span,
+// and the spans hold little else, at any angle, scale, and across the
+// frame's borders.
+TEST(MarkerRegion, SpansEveryPixelABilinearReadInsideTouchesAndLittleElse) {
+  constexpr int kWidth = 640, kHeight = 480;
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  for (int trial = 0; trial < 200; ++trial) {
+    const double px_per_m = 100.0 + 500.0 * unit(rng);
+    const double angle_rad = 2.0 * std::numbers::pi * unit(rng);
+    MarkerFrame m;
+    m.centre_u_px = -50.0 + (kWidth + 100.0) * unit(rng);
+    m.centre_v_px = -50.0 + (kHeight + 100.0) * unit(rng);
+    m.north_u = px_per_m * std::cos(angle_rad);
+    m.north_v = px_per_m * std::sin(angle_rad);
+    // East is North turned by −90° seen from below, as marker_frame gives.
+    m.east_u = m.north_v;
+    m.east_v = -m.north_u;
+    const double e0_m = -0.2 + 0.3 * unit(rng), n0_m = -0.2 + 0.3 * unit(rng);
+    const double e1_m = e0_m + 0.002 + 0.1 * unit(rng), n1_m = n0_m + 0.002 + 0.1 * unit(rng);
+    const MarkerRegion region(m, e0_m, e1_m, n0_m, n1_m, kWidth, kHeight);
+    const double step_px = 0.2;
+    const double de_m = step_px / px_per_m;
+    int outside = 0;
+    for (double e_m = e0_m; e_m <= e1_m; e_m += de_m) {
+      for (double n_m = n0_m; n_m <= n1_m; n_m += de_m) {
+        double u = 0.0, v = 0.0;
+        m.project(e_m, n_m, &u, &v);
+        for (int dy = 0; dy <= 1; ++dy) {
+          for (int dx = 0; dx <= 1; ++dx) {
+            const int x = static_cast<int>(std::floor(u)) + dx;
+            const int y = static_cast<int>(std::floor(v)) + dy;
+            if (x < 0 || y < 0 || x >= kWidth || y >= kHeight) continue;
+            const PixelSpan span =
+                y >= region.first_row() && y <= region.last_row() ? region.row(y) : PixelSpan{};
+            if (x < span.x0 || x > span.x1) ++outside;
+          }
+        }
+      }
+    }
+    EXPECT_EQ(outside, 0) << "trial " << trial;
+    // The spans: the padded region's area, and at most three pixels a row
+    // of rounding (each end to a whole pixel, both ends counted).
+    const double pad_m = 1.5 / px_per_m;
+    const double padded_px =
+        px_per_m * px_per_m * (e1_m - e0_m + 2.0 * pad_m) * (n1_m - n0_m + 2.0 * pad_m);
+    double spanned_px = 0.0;
+    int rows = 0;
+    for (int y = region.first_row(); y <= region.last_row(); ++y) {
+      const PixelSpan span = region.row(y);
+      spanned_px += std::max(0, span.x1 - span.x0 + 1);
+      ++rows;
+    }
+    EXPECT_LE(spanned_px, padded_px + 3.0 * rows) << "trial " << trial;
+  }
 }
 
 }  // namespace
