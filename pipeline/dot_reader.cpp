@@ -98,17 +98,22 @@ constexpr double kReferenceSpreadN = 0.1;
 
 MarkerRegion::MarkerRegion(const MarkerFrame& marker, double e0_m, double e1_m, double n0_m,
                            double n1_m, int width, int height)
-    : marker_(marker),
-      det_(marker.east_u * marker.north_v - marker.east_v * marker.north_u),
-      width_(width) {
+    : marker_(marker), width_(width) {
+  const double det = marker.east_u * marker.north_v - marker.east_v * marker.north_u;
   const double px_per_m = std::hypot(marker.north_u, marker.north_v);
-  if (!(std::abs(det_) > 0.0) || !(px_per_m > 0.0) || !(e0_m <= e1_m) || !(n0_m <= n1_m)) return;
+  if (!(std::abs(det) > 0.0) || !(px_per_m > 0.0) || !(e0_m <= e1_m) || !(n0_m <= n1_m)) return;
   // A bilinear read at the rectangle's rim touches the pixel beyond it.
   const double pad_m = 1.5 / px_per_m;
-  e0_m_ = e0_m - pad_m, e1_m_ = e1_m + pad_m, n0_m_ = n0_m - pad_m, n1_m_ = n1_m + pad_m;
+  e0_m -= pad_m, e1_m += pad_m, n0_m -= pad_m, n1_m += pad_m;
+  // (e, n) of image offset (du, dv) from the centre: the marker frame's
+  // inverse.
+  const double e_per_du = marker.north_v / det, e_per_dv = -marker.north_u / det;
+  const double n_per_du = -marker.east_v / det, n_per_dv = marker.east_u / det;
+  bounds_[0] = {e_per_dv, e_per_du == 0.0 ? 0.0 : 1.0 / e_per_du, e0_m, e1_m};
+  bounds_[1] = {n_per_dv, n_per_du == 0.0 ? 0.0 : 1.0 / n_per_du, n0_m, n1_m};
   double v_min = INFINITY, v_max = -INFINITY;
-  for (double e_m : {e0_m_, e1_m_}) {
-    for (double n_m : {n0_m_, n1_m_}) {
+  for (double e_m : {e0_m, e1_m}) {
+    for (double n_m : {n0_m, n1_m}) {
       double u = 0.0, v = 0.0;
       marker.project(e_m, n_m, &u, &v);
       v_min = std::min(v_min, v);
@@ -122,26 +127,22 @@ MarkerRegion::MarkerRegion(const MarkerFrame& marker, double e0_m, double e1_m, 
 
 PixelSpan MarkerRegion::row(int y) const {
   // Along row y, e and n are affine in u: each bounds u to an interval.
-  const MarkerFrame& m = marker_;
-  const double dv = y - m.centre_v_px;
-  const double e_at_centre_m = -dv * m.north_u / det_, n_at_centre_m = dv * m.east_u / det_;
-  const double e_per_px = m.north_v / det_, n_per_px = -m.east_v / det_;
+  const double dv = y - marker_.centre_v_px;
   double du_lo = -INFINITY, du_hi = INFINITY;
-  auto bound = [&](double at_centre_m, double per_px, double lo_m, double hi_m) {
-    if (per_px == 0.0) {
-      if (at_centre_m < lo_m || at_centre_m > hi_m) du_lo = INFINITY;
-      return;
+  for (const Bound& b : bounds_) {
+    const double at_m = dv * b.per_row_m;
+    if (b.px_per_m == 0.0) {
+      if (at_m < b.lo_m || at_m > b.hi_m) return {};
+      continue;
     }
-    const double a = (lo_m - at_centre_m) / per_px, b = (hi_m - at_centre_m) / per_px;
-    du_lo = std::max(du_lo, std::min(a, b));
-    du_hi = std::min(du_hi, std::max(a, b));
-  };
-  bound(e_at_centre_m, e_per_px, e0_m_, e1_m_);
-  bound(n_at_centre_m, n_per_px, n0_m_, n1_m_);
+    const double a = (b.lo_m - at_m) * b.px_per_m, c = (b.hi_m - at_m) * b.px_per_m;
+    du_lo = std::max(du_lo, std::min(a, c));
+    du_hi = std::min(du_hi, std::max(a, c));
+  }
   PixelSpan out;
   if (!(du_lo <= du_hi)) return out;
-  out.x0 = static_cast<int>(std::max(0.0, std::floor(m.centre_u_px + du_lo)));
-  out.x1 = static_cast<int>(std::min(width_ - 1.0, std::ceil(m.centre_u_px + du_hi)));
+  out.x0 = static_cast<int>(std::max(0.0, std::floor(marker_.centre_u_px + du_lo)));
+  out.x1 = static_cast<int>(std::min(width_ - 1.0, std::ceil(marker_.centre_u_px + du_hi)));
   return out;
 }
 
@@ -242,18 +243,6 @@ CodeReading read_code(const ImageView& frame, const MarkerFrame& marker, bool re
   out.code = code;
   out.margin = static_cast<float>(margin);
   return out;
-}
-
-void ask_code(const ImageView& frame, const MarkerFrame& marker, bool red,
-              const CeilingLayout& layout, double search_m) {
-  const double e_m = red ? layout.red_centre_e_m() : layout.green_centre_e_m();
-  const double dot_n_m = red ? layout.red_dot_n_m : layout.green_dot_n_m;
-  // The reference patches reach furthest East–West, the dots' search
-  // furthest North–South (slot_n_m(0) is the northernmost slot).
-  const double half_e_m = reference_spread_e_m(layout);
-  const double half_n_m = std::max(reference_limit_n_m(layout) + kReferenceSpreadN * dot_n_m,
-                                   layout.slot_n_m(0) + search_m);
-  ask_marker_region(frame, marker, e_m - half_e_m, e_m + half_e_m, -half_n_m, half_n_m);
 }
 
 bool dark_area_consistent(const RectangleCandidate& rect, int code, bool red,

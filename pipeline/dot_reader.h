@@ -44,9 +44,14 @@ class MarkerRegion {
   PixelSpan row(int y) const;
 
  private:
+  // One of the rectangle's two coordinates (e, n): dv·per_row_m at the
+  // centre's column of the row dv below the centre, changing 1/px_per_m
+  // per pixel along the row (px_per_m 0: not at all); within [lo_m, hi_m].
+  struct Bound {
+    double per_row_m = 0.0, px_per_m = 0.0, lo_m = 0.0, hi_m = 0.0;
+  };
   MarkerFrame marker_;
-  double e0_m_ = 0.0, e1_m_ = 0.0, n0_m_ = 0.0, n1_m_ = 0.0;
-  double det_ = 0.0;
+  std::array<Bound, 2> bounds_{};
   int width_ = 0;
   int first_row_ = 0, last_row_ = -1;
 };
@@ -77,11 +82,6 @@ float dot_threshold_ratio(const DetectorParams& params, double blur_px, double r
 CodeReading read_code(const ImageView& frame, const MarkerFrame& marker, bool red,
                       const CeilingLayout& layout, const DetectorParams& params,
                       float threshold_ratio, double search_m = -1.0);
-
-// Asks the memory system for the pixels read_code(frame, marker, red,
-// layout, ..., search_m) reads (search_m ≥ 0).
-void ask_code(const ImageView& frame, const MarkerFrame& marker, bool red,
-              const CeilingLayout& layout, double search_m);
 
 // Whether the dark pixels found inside a rectangle fit the dots its code
 // says it has: more dark area than the dots plus slack means dirt, an

@@ -401,15 +401,16 @@ void Pipeline::process_tracked(const ImageView& frame, PositioningMode mode, Fra
   StageClock clock(out);
   if (begin(frame, out) != Refusal::kNone) return clock.finish();
   // Nothing swept the frame: it is in memory, not in cache. Each marker's
-  // edge bands and dot rows are asked for one marker ahead of its reading
-  // (docs/pipeline_speed.md).
-  const double search_m = tracked_dot_search_m(config_.detector);
+  // image, with the reach of its edges' profiles, is asked for one marker
+  // ahead of its reading: row by row only its span, since DRAM's cost
+  // follows the rows more than their length (a tracked 640×480 frame's
+  // reading 17–22 % cheaper than asking for a square around the marker,
+  // docs/pipeline_speed.md).
+  const double half_e_m = config_.layout.rect_width_m + kEdgeProfileHalf_m;
+  const double half_n_m = 0.5 * config_.layout.rect_height_m + kEdgeProfileHalf_m;
   auto ask = [&](size_t k) {
-    if (k >= predicted.size()) return;
-    for (bool red : {true, false}) {
-      ask_edges(frame, predicted[k].frame, red, config_.layout);
-      ask_code(frame, predicted[k].frame, red, config_.layout, search_m);
-    }
+    if (k < predicted.size())
+      ask_marker_region(frame, predicted[k].frame, -half_e_m, half_e_m, -half_n_m, half_n_m);
   };
   ask(0);
   for (size_t k = 0; k < predicted.size(); ++k) {

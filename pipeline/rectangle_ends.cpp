@@ -280,29 +280,12 @@ EdgeCrossing measure_edge(const ImageView& frame, const MarkerFrame& marker, dou
                     channel, spread_m);
 }
 
-// The edges measure_edges measures: fn(end, e_m, n_m, de, dn, offset_m) for
-// the edge through marker point (e_m, n_m) with outward direction (de, dn)
-// and profiles ±offset_m along it; end 0 (North), 1 (South), −1 for the
-// outer long side (e = ±5 in) between each pair of neighbouring slots.
-template <typename Fn>
-void for_each_edge(bool red, const CeilingLayout& layout, Fn&& fn) {
-  const double centre_e_m = red ? layout.red_centre_e_m() : layout.green_centre_e_m();
-  for (int s = 0; s < 2; ++s) {
-    const double dn = s == 0 ? 1.0 : -1.0;
-    fn(s, centre_e_m, dn * 0.5 * layout.rect_height_m, 0.0, dn, kEndProfileOffset_m);
-  }
-  const double de = red ? 1.0 : -1.0;
-  for (int k = 0; k + 1 < layout.bits && k < kMaxSideCrossings; ++k) {
-    const double n_m = 0.5 * (layout.slot_n_m(k) + layout.slot_n_m(k + 1));
-    fn(-1, de * layout.rect_width_m, n_m, de, 0.0, kSideProfileOffset_m);
-  }
-}
-
 }  // namespace
 
 RectangleEdges measure_edges(const ImageView& frame, const MarkerFrame& marker, bool red,
                              const CeilingLayout& layout, EdgeLevels levels) {
   RectangleEdges out;
+  const double centre_e_m = red ? layout.red_centre_e_m() : layout.green_centre_e_m();
   const EdgeChannel channel = frame.chroma_halved ? EdgeChannel::kLuma
                               : red               ? EdgeChannel::kGreen
                                                   : EdgeChannel::kRed;
@@ -312,33 +295,27 @@ RectangleEdges measure_edges(const ImageView& frame, const MarkerFrame& marker, 
       std::clamp(static_cast<int>(2.0 * kEdgeProfileHalf_m * px_per_m) + 1, 5, kMaxSamples);
   double spread_sum_m = 0.0;
   int spreads = 0;
-  for_each_edge(red, layout,
-                [&](int end, double e_m, double n_m, double de, double dn, double offset_m) {
-                  double spread_m = NAN;
-                  const EdgeCrossing c = measure_edge(frame, marker, e_m, n_m, de, dn, offset_m,
-                                                      samples, levels, channel, &spread_m);
-                  if (end < 0) {
-                    if (c.found) out.side[static_cast<size_t>(out.side_count++)] = c;
-                    return;
-                  }
-                  out.end[static_cast<size_t>(end)] = c;
-                  if (std::isnan(spread_m)) return;
-                  spread_sum_m += spread_m;
-                  ++spreads;
-                });
+  for (int s = 0; s < 2; ++s) {
+    const double dn = s == 0 ? 1.0 : -1.0;
+    double spread_m = NAN;
+    out.end[static_cast<size_t>(s)] =
+        measure_edge(frame, marker, centre_e_m, dn * 0.5 * layout.rect_height_m, 0.0, dn,
+                     kEndProfileOffset_m, samples, levels, channel, &spread_m);
+    if (std::isnan(spread_m)) continue;
+    spread_sum_m += spread_m;
+    ++spreads;
+  }
   if (spreads > 0) out.spread_px = spread_sum_m / spreads * px_per_m;
+  // The outer long side: e = ±5 in, between each pair of neighbouring slots.
+  const double de = red ? 1.0 : -1.0;
+  for (int k = 0; k + 1 < layout.bits && out.side_count < kMaxSideCrossings; ++k) {
+    const double n_m = 0.5 * (layout.slot_n_m(k) + layout.slot_n_m(k + 1));
+    double spread_m = NAN;
+    const EdgeCrossing c = measure_edge(frame, marker, de * layout.rect_width_m, n_m, de, 0.0,
+                                        kSideProfileOffset_m, samples, levels, channel, &spread_m);
+    if (c.found) out.side[static_cast<size_t>(out.side_count++)] = c;
+  }
   return out;
-}
-
-void ask_edges(const ImageView& frame, const MarkerFrame& marker, bool red,
-               const CeilingLayout& layout) {
-  for_each_edge(
-      red, layout, [&](int, double e_m, double n_m, double de, double dn, double offset_m) {
-        const double half_e_m = std::abs(de) * kEdgeProfileHalf_m + std::abs(dn) * offset_m;
-        const double half_n_m = std::abs(dn) * kEdgeProfileHalf_m + std::abs(de) * offset_m;
-        ask_marker_region(frame, marker, e_m - half_e_m, e_m + half_e_m, n_m - half_n_m,
-                          n_m + half_n_m);
-      });
 }
 
 double edge_spread_px(const ImageView& frame, const MarkerFrame& marker, bool red,

@@ -67,12 +67,6 @@ RectangleEdges measure_edges(const ImageView& frame, const MarkerFrame& marker, 
                              const CeilingLayout& layout,
                              EdgeLevels levels = EdgeLevels::kDarkestLevel);
 
-// Asks the memory system (a prefetch hint: no effect on results) for the
-// pixels measure_edges(frame, marker, red, layout, ...) reads: each edge's
-// band, not the marker's whole box.
-void ask_edges(const ImageView& frame, const MarkerFrame& marker, bool red,
-               const CeilingLayout& layout);
-
 // Blur along North at the rectangle's two short ends, in pixels
 // (measure_edges().spread_px): 0.5 px for a sharp edge, 1.35 σ for
 // Gaussian blur, half the length of motion blur along North; negative when
