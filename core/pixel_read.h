@@ -173,16 +173,6 @@ inline void read_rgb_2x2(const ImageView& f, int x, int y, std::array<Rgb, 4>* o
   });
 }
 
-// The same four pixels' pixel_edge_level; 0 for MJPEG.
-inline void read_edge_level_2x2(const ImageView& f, int x, int y, EdgeChannel channel,
-                                std::array<uint8_t, 4>* out) {
-  out->fill(0);
-  with_pixel_format(f.format, [&](auto tag) {
-    for (int k = 0; k < 4; ++k)
-      (*out)[k] = pixel_edge_level<decltype(tag)::value>(f, x + (k & 1), y + (k >> 1), channel);
-  });
-}
-
 // The same four pixels' darkest channels (pixel_darkest); 0 for MJPEG.
 inline void read_darkest_2x2(const ImageView& f, int x, int y, std::array<uint8_t, 4>* out) {
   out->fill(0);

@@ -282,7 +282,8 @@ void LsqSolver::optimise(const ViewGeometry& view, const PositioningParams& para
   constexpr int kN = kLsqParams;
   constexpr double kLambdaStart = 1e-4;
   // A step's predicted gain, as a share of the cost, below which the fit
-  // has converged: a pose moved by ~1e-9 of its noise.
+  // has converged: with n residuals it moves the pose by about
+  // √(n · 1e-9) of the pose's own standard deviation (3e-4 for 100).
   constexpr double kNegligibleGain = 1e-9;
   LsqState& st = fit->state;
   const std::span<bool> use(fit->use.data(), fixes.size());

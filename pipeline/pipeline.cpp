@@ -21,9 +21,6 @@ constexpr double kRecentreEdges_px = 1.0;
 // How far along North an edge-tracked marker's dots are sought from their
 // slots (a whole sweep: detector.dot_search_m, 1 in).
 constexpr double kTrackedDotSearch_m = 0.25 * kInch_m;
-double tracked_dot_search_m(const DetectorParams& detector) {
-  return std::min(detector.dot_search_m, kTrackedDotSearch_m);
-}
 
 void check_size(const CameraIntrinsics& k) {
   if (k.width <= 0 || k.height <= 0) {
@@ -261,7 +258,8 @@ PairOutcome Pipeline::measure_predicted(const ImageView& frame, const PredictedM
   // dot_search_m (which allows for a frame fitted to blurred centroids).
   CodeReading code_i, code_j;
   const PairOutcome read =
-      read_codes(frame, m, red_edges, tracked_dot_search_m(config_.detector), &code_i, &code_j);
+      read_codes(frame, m, red_edges, std::min(config_.detector.dot_search_m, kTrackedDotSearch_m),
+                 &code_i, &code_j);
   if (read != PairOutcome::kDecoded) return read;
   if (code_i.code != predicted.code_i || code_j.code != predicted.code_j)
     return PairOutcome::kInconsistent;

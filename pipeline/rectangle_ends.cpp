@@ -112,8 +112,8 @@ bool read_fitted_profile(const ImageView& frame, const MarkerFrame& marker, doub
 // light. Each step moves one whole pixel along the dominant axis, so the
 // bilinear weights along it are the same for every sample: the profile is
 // stepped rather than projected, and its format dispatched once (a tracked
-// 640×480 frame's edges in ~half the time). False when a sample leaves the
-// frame.
+// 640×480 drive frame's measuring, warm: RGB 87 → 58 µs, YUYV 99 → 82 µs).
+// False when a sample leaves the frame.
 template <PixelFormat F>
 bool read_axis_profile(const ImageView& frame, const MarkerFrame& marker, double e_m, double n_m,
                        double de, double dn, const ProfileSteps& steps, EdgeChannel channel,

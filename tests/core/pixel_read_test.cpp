@@ -1,6 +1,6 @@
-// read_rgb_2x2, read_darkest_2x2 and read_edge_level_2x2, the bilinear
-// samples' readers (dot slots, rectangle edges), give each of their four
-// pixels exactly as read_rgb does, in every format: random bytes, every position, odd and even
+// read_rgb_2x2, read_darkest_2x2 and pixel_edge_level, the bilinear
+// samples' readers (dot slots, rectangle edges), give each pixel exactly as
+// read_rgb does, in every format: random bytes, every position, odd and even
 // columns and rows.
 #include "core/pixel_read.h"
 
@@ -73,16 +73,18 @@ TEST(PixelRead, TwoByTwoDarkestIsTheLeastChannelOfReadRgbInEveryFormat) {
   });
 }
 
-// read_edge_level_2x2: RGB and BGR give the asked channel of read_rgb (or
+// pixel_edge_level: RGB and BGR give the asked channel of read_rgb (or
 // its BT.601 luma), grey its level, and YUV formats their luma byte in full range (the level a
 // Y of 16 / 235 stands for: 0 / 255), whatever the chroma.
 TEST(PixelRead, TwoByTwoEdgeLevelsAreTheChannelOrTheLumaInEveryFormat) {
   for_every_block(13, [](const ImageView& view, int x, int y, const std::string& where) {
     for (EdgeChannel channel : {EdgeChannel::kRed, EdgeChannel::kGreen, EdgeChannel::kLuma}) {
-      std::array<uint8_t, 4> block;
-      read_edge_level_2x2(view, x, y, channel, &block);
       for (int k = 0; k < 4; ++k) {
         const int px = x + (k & 1), py = y + (k >> 1);
+        uint8_t level = 0;
+        with_pixel_format(view.format, [&](auto tag) {
+          level = pixel_edge_level<decltype(tag)::value>(view, px, py, channel);
+        });
         uint8_t r = 0, g = 0, b = 0;
         read_rgb(view, px, py, &r, &g, &b);
         uint8_t expected = channel == EdgeChannel::kRed     ? r
@@ -93,7 +95,7 @@ TEST(PixelRead, TwoByTwoEdgeLevelsAreTheChannelOrTheLumaInEveryFormat) {
         } else if (is_yuv420(view.format)) {
           expected = yuv_channel(yuv_luma_part(view.row(py)[px]), 0);
         }
-        EXPECT_EQ(block[k], expected) << where << " pixel " << k;
+        EXPECT_EQ(level, expected) << where << " pixel " << k;
       }
     }
   });
