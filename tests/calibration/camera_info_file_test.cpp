@@ -7,7 +7,7 @@
 #include <string>
 
 #include "calibration/calibration_files.h"
-#include "tests/calibration/temp_file.h"
+#include "tests/support/temp_file.h"
 
 namespace ceilpose {
 namespace {

@@ -12,22 +12,17 @@
 #include <cerrno>
 #include <chrono>
 #include <cstring>
-#include <fstream>
 #include <sstream>
 #include <stdexcept>
 
 #include "ipc/shm/shm_fleet_writer.h"
 #include "ipc/shm/shm_pose_writer.h"
+#include "tests/support/temp_file.h"
 
 namespace ceilpose::test {
 namespace {
 
 std::atomic<int> g_counter{0};
-
-std::string temp_path(const std::string& stem) {
-  return ::testing::TempDir() + "ceilposed-" + std::to_string(getpid()) + "-" +
-         std::to_string(g_counter.fetch_add(1)) + "-" + stem;
-}
 
 ChildOptions daemon_options(const std::map<std::string, std::string>& env, int stdout_fd) {
   ChildOptions options;
@@ -126,9 +121,7 @@ void remove_daemon_segments(const std::string& shm) {
 }
 
 std::string write_temp_file(const std::string& stem, const std::string& text) {
-  const std::string path = temp_path(stem);
-  std::ofstream(path) << text;
-  return path;
+  return write_temp("ceilposed", std::to_string(g_counter.fetch_add(1)) + "-" + stem, text);
 }
 
 }  // namespace ceilpose::test
