@@ -16,6 +16,10 @@ std::string_view to_string(PositioningMode mode) {
   return "unknown";
 }
 
+bool positions_from_centroids(PositioningMode mode) {
+  return mode == PositioningMode::kChangeOfAxes || mode == PositioningMode::kBarycentric;
+}
+
 bool parse_positioning_mode(std::string_view text, PositioningMode* mode) {
   for (auto m : kPositioningModes) {
     if (text == to_string(m)) {

@@ -31,4 +31,11 @@ bool parse_positioning_mode(std::string_view text, PositioningMode* mode);
 std::vector<std::string> positioning_mode_names();  // in kPositioningModes order
 std::string positioning_mode_list();                // "auto, axes, barycentric or lsq"
 
+// Whether the mode positions from the rectangles' centroids: the thesis's
+// two do (a marker's centre and heading), least squares and auto from every
+// point, the edges' among them. An edge-tracked frame measures no
+// centroids, so these modes track with the windows' sweep (a 25 ms
+// readout's drive, axes p99 2.5 -> 3.0 mm with edges).
+bool positions_from_centroids(PositioningMode mode);
+
 }  // namespace ceilpose

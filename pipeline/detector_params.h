@@ -137,7 +137,9 @@ struct DetectorParams {
   // rectangles' centroids are not measured, and their dark-area check not
   // made); false: the labeler sweeps windows around them. Both are at
   // least as accurate as a whole sweep on every scenario set; the edges
-  // cost about half (docs/pipeline_speed.md, docs/decisions.md).
+  // cost about half (docs/pipeline_speed.md, docs/decisions.md). The
+  // thesis's modes (axes, barycentric) sweep windows whatever it says: they
+  // position from centroids (positions_from_centroids).
   bool track_edges = true;
   int full_sweep_every = 30;
   // Window margin around a marker's predicted outline: this many pixels...

@@ -19,17 +19,6 @@ bool finite_motion(const MotionEstimate& m) {
   return !m.valid || (all_finite(m.state.x) && all_finite(m.state.p));
 }
 
-// Edge-tracked frames measure no centroids, which the thesis modes position
-// from (their rectangle centres would be the ends' midpoints: a 25 ms
-// readout's drive p99 2.5 -> 3.0 mm for axes): those modes track with the
-// windows' sweep. lsq and auto position from the edges.
-PipelineConfig tracking_for_mode(PipelineConfig config) {
-  const PositioningMode mode = config.positioning.mode;
-  if (mode == PositioningMode::kChangeOfAxes || mode == PositioningMode::kBarycentric)
-    config.detector.track_edges = false;
-  return config;
-}
-
 }  // namespace
 
 PipelineConfig with_mode(PipelineConfig config, PositioningMode mode, bool filter) {
@@ -39,14 +28,14 @@ PipelineConfig with_mode(PipelineConfig config, PositioningMode mode, bool filte
 }
 
 Localizer::Localizer(const PipelineConfig& config)
-    : pipeline_(tracking_for_mode(config)),
+    : pipeline_(config),
       filter_(config.filter),
       view_(config),
       decoded_last_(static_cast<size_t>(view_.map().codes()) * view_.map().codes(), 0),
       result_(std::make_unique<FrameResult>()) {}
 
 void Localizer::reconfigure(const PipelineConfig& config, bool reset_filter) {
-  pipeline_.set_config(tracking_for_mode(config));
+  pipeline_.set_config(config);
   view_ = ViewGeometry(config);
   decoded_last_.assign(static_cast<size_t>(view_.map().codes()) * view_.map().codes(), 0);
   last_decoded_count_ = 0;
@@ -71,7 +60,7 @@ const Localization& Localizer::localize(const ImageView& image, const FrameInfo&
   FullSweepReason sweep = plan_sweep();
   out_.swept_px = 0;
   if (sweep == FullSweepReason::kNone) {
-    if (config.detector.track_edges) {
+    if (plan_.edges) {
       pipeline_.process_tracked(image, config.positioning.mode, result_.get(), motion,
                                 plan_.predicted_span());
     } else {
@@ -174,7 +163,8 @@ FullSweepReason Localizer::plan_sweep() {
   if (!c.detector.tracking || !c.filter.enabled) return FullSweepReason::kOff;
   if (!fix) return FullSweepReason::kNoFix;
   if (frames_since_full_ + 1 >= c.detector.full_sweep_every) return FullSweepReason::kScheduled;
-  return plan_tracking(view_, c.detector, predicted_, prediction_errors_, &plan_);
+  return plan_tracking(view_, c.detector, c.positioning.mode, predicted_, prediction_errors_,
+                       &plan_);
 }
 
 // A tracked sweep stands only when it decoded again every marker the last

@@ -77,8 +77,8 @@ bool marker_frame_at(const ViewGeometry& view, const MarkerPlacement& p, const M
 }  // namespace
 
 FullSweepReason plan_tracking(const ViewGeometry& view, const DetectorParams& params,
-                              const MotionState& s, const PredictionErrors& errors,
-                              TrackingPlan* plan) {
+                              PositioningMode mode, const MotionState& s,
+                              const PredictionErrors& errors, TrackingPlan* plan) {
   const CameraIntrinsics& k = view.intrinsics();
   const CeilingLayout& layout = view.layout();
   const Pose2D robot{s.x[0], s.x[1], s.x[2]};
@@ -100,6 +100,7 @@ FullSweepReason plan_tracking(const ViewGeometry& view, const DetectorParams& pa
       params.track_margin_px +
       params.track_margin_errors * (error_m * px_per_m + error_rad * half_diagonal_px) + readout_px;
   plan->margin_px = margin_px;
+  plan->edges = params.track_edges && !positions_from_centroids(mode);
   plan->window_count = 0;
   plan->expected_whole = 0;
   plan->predicted_count = 0;
@@ -187,7 +188,7 @@ FullSweepReason plan_tracking(const ViewGeometry& view, const DetectorParams& pa
       // Whole beyond doubt: inside the frame even if the prediction is off
       // by the whole margin.
       if (x0 >= 0.0 && y0 >= 0.0 && x1 <= w && y1 <= h) {
-        if (params.track_edges) {
+        if (plan->edges) {
           // Its frame where its centre row is exposed (the prediction is the
           // centre row's): two passes find the row.
           PredictedMarker& pm = plan->predicted[static_cast<size_t>(plan->predicted_count)];
@@ -203,7 +204,7 @@ FullSweepReason plan_tracking(const ViewGeometry& view, const DetectorParams& pa
       }
     }
   }
-  if (params.track_edges) {
+  if (plan->edges) {
     // Edge-tracked frames sweep no window, so the windows' area does not
     // matter: the profiles across each predicted edge must cross it, which
     // they do while the prediction's likely error (the margin less its

@@ -17,6 +17,7 @@
 #include <span>
 
 #include "core/motion_model.h"
+#include "core/positioning_mode.h"
 #include "core/view_geometry.h"
 #include "pipeline/components.h"
 #include "pipeline/detector_params.h"
@@ -42,9 +43,11 @@ struct TrackingPlan {
   // sweep does not was not where its window looked.
   std::array<int32_t, kMaxMarkersPerFrame> whole{};
   int expected_whole = 0;
-  // With detector.track_edges, the same markers where they will be
-  // (whole[k] is predicted[k]'s); none otherwise (no work a windows' sweep
-  // would not read).
+  // Edge-tracked (detector.track_edges, in a mode that positions from the
+  // edges): the same markers where they will be (whole[k] is
+  // predicted[k]'s), which the frame measures instead of sweeping windows;
+  // none otherwise (no work a windows' sweep would not read).
+  bool edges = false;
   std::array<PredictedMarker, kMaxMarkersPerFrame> predicted{};
   int predicted_count = 0;
   std::span<const PredictedMarker> predicted_span() const {
@@ -91,12 +94,13 @@ enum class FullSweepReason : uint8_t {
 };
 const char* to_string(FullSweepReason reason);
 
-// Plans the windows for the robot state `s` (the filter's, predicted to the
-// frame's time; the camera's readout_ms widens them) whose predictions have
-// erred by `errors`. Returns kNone and fills `plan`, or the reason to sweep
-// the whole frame.
+// Plans the windows (or, edge-tracked, the markers) for positioning `mode`
+// and the robot state `s` (the filter's, predicted to the frame's time; the
+// camera's readout_ms widens them) whose predictions have erred by
+// `errors`. Returns kNone and fills `plan`, or the reason to sweep the whole
+// frame.
 FullSweepReason plan_tracking(const ViewGeometry& view, const DetectorParams& params,
-                              const MotionState& s, const PredictionErrors& errors,
-                              TrackingPlan* plan);
+                              PositioningMode mode, const MotionState& s,
+                              const PredictionErrors& errors, TrackingPlan* plan);
 
 }  // namespace ceilpose

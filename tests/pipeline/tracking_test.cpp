@@ -174,10 +174,12 @@ TEST(PlanTracking, WindowsHoldEveryWholeMarkerAndGrowWithThePredictionsErrors) {
   s.x[0] = 2.1, s.x[1] = 2.0, s.x[2] = 0.3;
   PredictionErrors errors;
   TrackingPlan plan;
-  EXPECT_EQ(plan_tracking(view, config.detector, s, errors, &plan), FullSweepReason::kNoFix)
+  EXPECT_EQ(plan_tracking(view, config.detector, config.positioning.mode, s, errors, &plan),
+            FullSweepReason::kNoFix)
       << "no prediction has been checked yet";
   for (int k = 0; k < 6; ++k) errors.add(0.0002, 0.0002);
-  ASSERT_EQ(plan_tracking(view, config.detector, s, errors, &plan), FullSweepReason::kNone);
+  ASSERT_EQ(plan_tracking(view, config.detector, config.positioning.mode, s, errors, &plan),
+            FullSweepReason::kNone);
   const XPose pose{2.1, 2.0, 0.3};
   const std::vector<XVisibleMarker> whole = whole_markers(XCamera{}, XMount{}, pose);
   ASSERT_GE(whole.size(), 6u);
@@ -197,10 +199,23 @@ TEST(PlanTracking, WindowsHoldEveryWholeMarkerAndGrowWithThePredictionsErrors) {
   PipelineConfig windows_only = config;
   windows_only.detector.track_edges = false;
   TrackingPlan windows_plan;
-  ASSERT_EQ(plan_tracking(view, windows_only.detector, s, errors, &windows_plan),
-            FullSweepReason::kNone);
+  ASSERT_EQ(
+      plan_tracking(view, windows_only.detector, config.positioning.mode, s, errors, &windows_plan),
+      FullSweepReason::kNone);
   EXPECT_TRUE(windows_plan.predicted_span().empty()) << "nothing predicted a sweep will not read";
+  EXPECT_FALSE(windows_plan.edges);
+  EXPECT_TRUE(plan.edges);
   EXPECT_EQ(windows_plan.expected_whole, plan.expected_whole);
+  // The thesis modes position from centroids, which an edge-tracked frame
+  // does not measure: with track_edges asked for, they plan windows.
+  for (PositioningMode mode : {PositioningMode::kChangeOfAxes, PositioningMode::kBarycentric}) {
+    TrackingPlan thesis_plan;
+    ASSERT_EQ(plan_tracking(view, config.detector, mode, s, errors, &thesis_plan),
+              FullSweepReason::kNone);
+    EXPECT_FALSE(thesis_plan.edges) << to_string(mode);
+    EXPECT_TRUE(thesis_plan.predicted_span().empty()) << to_string(mode);
+    EXPECT_EQ(thesis_plan.window_count, windows_plan.window_count) << to_string(mode);
+  }
   for (const PredictedMarker& pm : plan.predicted_span()) {
     const auto truth = std::find_if(whole.begin(), whole.end(), [&](const auto& m) {
       return m.i == pm.code_i && m.j == pm.code_j;
@@ -219,13 +234,15 @@ TEST(PlanTracking, WindowsHoldEveryWholeMarkerAndGrowWithThePredictionsErrors) {
 
   PredictionErrors worse;
   for (int k = 0; k < 6; ++k) worse.add(0.02, 0.01);  // 20 mm and 0.6 degrees
-  ASSERT_NE(plan_tracking(view, config.detector, s, worse, &plan), FullSweepReason::kNoFix);
+  ASSERT_NE(plan_tracking(view, config.detector, config.positioning.mode, s, worse, &plan),
+            FullSweepReason::kNoFix);
   EXPECT_GT(plan.margin_px,
             small_margin_px +
                 config.detector.track_margin_errors * (0.02 - 0.0002) * 530.0 / 2.1336 - 0.5);
   PredictionErrors lost;
   for (int k = 0; k < 6; ++k) lost.add(0.5, 0.5);
-  EXPECT_EQ(plan_tracking(view, config.detector, s, lost, &plan), FullSweepReason::kUncertain);
+  EXPECT_EQ(plan_tracking(view, config.detector, config.positioning.mode, s, lost, &plan),
+            FullSweepReason::kUncertain);
 }
 
 // An edge-tracked frame of the independent renderer at `pose`, and the plan
@@ -244,7 +261,8 @@ EdgeTrackedScene edge_tracked_scene(const XPose& pose) {
   s.x[0] = pose.x_m, s.x[1] = pose.y_m, s.x[2] = pose.yaw_rad;
   PredictionErrors errors;
   for (int k = 0; k < 6; ++k) errors.add(0.0002, 0.0002);
-  EXPECT_EQ(plan_tracking(view, scene.config.detector, s, errors, &scene.plan),
+  EXPECT_EQ(plan_tracking(view, scene.config.detector, scene.config.positioning.mode, s, errors,
+                          &scene.plan),
             FullSweepReason::kNone);
   XRenderOptions options;
   options.noise_sigma = 2.0;
