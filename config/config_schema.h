@@ -165,6 +165,7 @@ void describe(V& v, ServiceConfig& c) {
     v.field("quality_zero_pair_score", d.quality_zero_pair_score, 0.001f, 100.0f);
     v.field("tracking", d.tracking);
     v.field("track_edges", d.track_edges);
+    v.field("halve_whole_sweeps", d.halve_whole_sweeps);
     v.field("full_sweep_every", d.full_sweep_every, 1, 1000000);
     v.field("track_margin_px", d.track_margin_px, 0.0f, 1000.0f);
     v.field("track_margin_errors", d.track_margin_errors, 0.0f, 100.0f);

@@ -32,6 +32,8 @@ constexpr size_t kRowPadding = 8;
 // Windows side by side that a sweep's span table holds without growing
 // (a tracked frame has one per marker in view, a dozen).
 constexpr size_t kReservedSpansPerRow = 32;
+// Sampled rows a halved sweep asks for ahead of the one it reads.
+constexpr int kHalvedRowsAhead = 2;
 
 // x86-64's baseline (SSE2) has no 32-bit vector multiply, so the BT.601
 // arithmetic is also compiled for AVX2 and picked at load time where the
@@ -86,6 +88,29 @@ CEILPOSE_VECTOR_CLONES void interpolate_chroma(const int16_t* __restrict pair4,
   }
 }
 
+// Luma and chroma x16 of pixels 0, 2, 4, .. of a row: each pair's first
+// pixel with the pair's own chroma.
+CEILPOSE_VECTOR_CLONES void yuyv_halved(const uint8_t* __restrict q, int16_t* __restrict luma,
+                                        int16_t* __restrict u16, int16_t* __restrict v16, int n) {
+  for (int i = 0; i < n; ++i) {
+    luma[i] = q[4 * i];
+    u16[i] = static_cast<int16_t>(16 * q[4 * i + 1]);
+    v16[i] = static_cast<int16_t>(16 * q[4 * i + 3]);
+  }
+}
+// The same from 4:2:0 planes: chroma samples `step` bytes apart (NV12 2,
+// I420 1), the pixel's own chroma row.
+CEILPOSE_VECTOR_CLONES void planar_halved(const uint8_t* __restrict q, const uint8_t* __restrict u,
+                                          const uint8_t* __restrict v, int step,
+                                          int16_t* __restrict luma, int16_t* __restrict u16,
+                                          int16_t* __restrict v16, int n) {
+  for (int i = 0; i < n; ++i) {
+    luma[i] = q[2 * i];
+    u16[i] = static_cast<int16_t>(16 * u[step * i]);
+    v16[i] = static_cast<int16_t>(16 * v[step * i]);
+  }
+}
+
 // BT.601 (video range) from luma and chroma x16 to 0..255 levels, in ints
 // scaled by 2^12. A function of its own so that the compiler knows the
 // arrays do not overlap and vectorises the loop.
@@ -101,6 +126,28 @@ CEILPOSE_VECTOR_CLONES void bt601_levels(const int16_t* __restrict luma,
     g[i] = level(c - 100 * d - 208 * e);
     b[i] = level(c + 516 * d);
   }
+}
+
+// The fused lookup of `count` RGB (or BGR) pixels kStep bytes apart from
+// `p` into out[0..count).
+template <int kStep>
+void lookup_rgb(const uint8_t* p, bool rgb, const ColorClassifier& classifier, uint8_t* out,
+                int count) {
+  const uint8_t* lut = classifier.lut();
+  const uint32_t* t0 = classifier.table(rgb ? 0 : 2);
+  const uint32_t* t1 = classifier.table(1);
+  const uint32_t* t2 = classifier.table(rgb ? 2 : 0);
+  for (int i = 0; i < count; ++i, p += kStep) out[i] = lut[t0[p[0]] | t1[p[1]] | t2[p[2]]];
+}
+
+// The fused lookup of `count` pixels' normalisation-table levels.
+void lookup_levels(const uint8_t* r, const uint8_t* g, const uint8_t* b,
+                   const ColorClassifier& classifier, uint8_t* out, int count) {
+  const uint8_t* lut = classifier.lut();
+  const uint32_t* tr = classifier.table(0);
+  const uint32_t* tg = classifier.table(1);
+  const uint32_t* tb = classifier.table(2);
+  for (int i = 0; i < count; ++i) out[i] = lut[tr[r[i]] | tg[g[i]] | tb[b[i]]];
 }
 
 }  // namespace
@@ -205,33 +252,20 @@ void ComponentLabeler::classify_yuv_span(const ImageView& frame, int y, int x0, 
   interpolate_chroma(pv, px_v_.data() + 2 * p0, pairs);
   bt601_levels(py + x0, px_u_.data() + x0, px_v_.data() + x0, px_r_.data() + x0, px_g_.data() + x0,
                px_b_.data() + x0, x1 - x0 + 1);
-  const uint8_t* r = px_r_.data();
-  const uint8_t* g = px_g_.data();
-  const uint8_t* b = px_b_.data();
-  const uint8_t* lut = classifier.lut();
-  const uint32_t* tr = classifier.table(0);
-  const uint32_t* tg = classifier.table(1);
-  const uint32_t* tb = classifier.table(2);
-  uint8_t* out = row_class_.data();
-  for (int x = x0; x <= x1; ++x) out[x] = lut[tr[r[x]] | tg[g[x]] | tb[b[x]]];
+  lookup_levels(px_r_.data() + x0, px_g_.data() + x0, px_b_.data() + x0, classifier,
+                row_class_.data() + x0, x1 - x0 + 1);
 }
 
 void ComponentLabeler::classify_span(const ImageView& frame, int y, int x0, int x1,
                                      const ColorClassifier& classifier) {
   const uint8_t* row = frame.row(y);
   uint8_t* out = row_class_.data();
-  const uint8_t* lut = classifier.lut();
   switch (frame.format) {
     case PixelFormat::kRgb24:
-    case PixelFormat::kBgr24: {
-      const bool rgb = frame.format == PixelFormat::kRgb24;
-      const uint32_t* t0 = classifier.table(rgb ? 0 : 2);
-      const uint32_t* t1 = classifier.table(1);
-      const uint32_t* t2 = classifier.table(rgb ? 2 : 0);
-      const uint8_t* p = row + 3 * x0;
-      for (int x = x0; x <= x1; ++x, p += 3) out[x] = lut[t0[p[0]] | t1[p[1]] | t2[p[2]]];
+    case PixelFormat::kBgr24:
+      lookup_rgb<3>(row + 3 * x0, frame.format == PixelFormat::kRgb24, classifier, out + x0,
+                    x1 - x0 + 1);
       return;
-    }
     case PixelFormat::kYuyv:
     case PixelFormat::kNv12:
     case PixelFormat::kYuv420:
@@ -270,7 +304,7 @@ bool ComponentLabeler::encode_row(int y, int x0, int x1) {
       // Keep a dark run only while it may still be enclosed: it must start
       // right after a coloured run.
       if (in_row > 0 && runs_[run_count_ - 1].x1 + 1 == run_x0) {
-        if (run_count_ >= run_budget_) return false;
+        if (run_count_ >= run_budget_) return abandon();
         runs_[run_count_++] = Run{run_x0, run_x1, y, 0, PixelClass::kDark, false};
       }
       continue;
@@ -286,7 +320,7 @@ bool ComponentLabeler::encode_row(int y, int x0, int x1) {
         continue;
       }
     }
-    if (run_count_ >= run_budget_) return false;
+    if (run_count_ >= run_budget_) return abandon();
     runs_[run_count_] = Run{run_x0,
                             run_x1,
                             y,
@@ -298,6 +332,17 @@ bool ComponentLabeler::encode_row(int y, int x0, int x1) {
   }
   if (run_count_ > row_begin && runs_[run_count_ - 1].cls == PixelClass::kDark) --run_count_;
   return true;
+}
+
+bool ComponentLabeler::abandon() {
+  run_count_ = 0;
+  return false;
+}
+
+void ComponentLabeler::join_row(int cur_begin, int* prev_begin, int* prev_end) {
+  join_rows(*prev_begin, *prev_end, cur_begin, run_count_);
+  *prev_begin = cur_begin;
+  *prev_end = run_count_;
 }
 
 int32_t ComponentLabeler::find(int32_t i) {
@@ -329,7 +374,7 @@ void ComponentLabeler::join_rows(int prev_begin, int prev_end, int cur_begin, in
   }
 }
 
-void ComponentLabeler::accumulate() {
+void ComponentLabeler::accumulate(int width, int height) {
   comp_count_ = 0;
   for (int i = 0; i < run_count_; ++i) {
     const Run& run = runs_[i];
@@ -378,7 +423,7 @@ void ComponentLabeler::accumulate() {
     c.mu11 = s[3] / a - c.cx * c.cy;
     c.mu02 = s[4] / a - c.cy * c.cy;
     const bool frame_edge =
-        c.x_min == 0 || c.y_min == 0 || c.x_max == width_ - 1 || c.y_max == height_ - 1;
+        c.x_min == 0 || c.y_min == 0 || c.x_max == width - 1 || c.y_max == height - 1;
     c.touches_border = frame_edge || window_edge_[k] != 0;
     if (window_edge_[k] != 0 && c.cls != PixelClass::kDark &&
         4 * c.area_px >= params_.min_rect_area_px) {
@@ -455,14 +500,22 @@ void ComponentLabeler::plan_spans(const ImageView& frame, std::span<const PixelW
   }
 }
 
-bool ComponentLabeler::sweep_rows(const ImageView& frame, const ColorClassifier& classifier) {
+ComponentLabeler::SweepStart ComponentLabeler::begin_sweep(const ImageView& frame) {
   run_count_ = 0;
   comp_count_ = 0;
   window_cuts_ = 0;
   swept_px_ = 0;
-  if (frame.width != width_ || frame.height != height_ || frame.empty()) return false;
+  if (frame.width != width_ || frame.height != height_ || frame.empty())
+    return SweepStart::kRefused;
   // Grey frames carry no colour: nothing can be red or green.
-  if (frame.format == PixelFormat::kGray8 || frame.format == PixelFormat::kMjpeg) return true;
+  if (frame.format == PixelFormat::kGray8 || frame.format == PixelFormat::kMjpeg)
+    return SweepStart::kNoColour;
+  return SweepStart::kSweep;
+}
+
+bool ComponentLabeler::sweep_rows(const ImageView& frame, const ColorClassifier& classifier) {
+  const SweepStart start = begin_sweep(frame);
+  if (start != SweepStart::kSweep) return start == SweepStart::kNoColour;
   int y_begin = height_, y_end = -1;
   for (const SweptWindow& w : swept_) {
     y_begin = std::min(y_begin, w.y0);
@@ -502,16 +555,86 @@ bool ComponentLabeler::sweep_rows(const ImageView& frame, const ColorClassifier&
         row_edge_[x0] = 0;
         row_edge_[x1] = 0;
       }
-      if (!ok) {
-        run_count_ = 0;
-        return false;
-      }
+      if (!ok) return false;
     }
-    join_rows(prev_begin, prev_end, cur_begin, run_count_);
-    prev_begin = cur_begin;
-    prev_end = run_count_;
+    join_row(cur_begin, &prev_begin, &prev_end);
   }
-  accumulate();
+  accumulate(width_, height_);
+  return true;
+}
+
+void ComponentLabeler::classify_halved_row(const ImageView& frame, int y, int count,
+                                           const ColorClassifier& classifier) {
+  const uint8_t* row = frame.row(y);
+  uint8_t* out = row_class_.data();
+  switch (frame.format) {
+    case PixelFormat::kRgb24:
+    case PixelFormat::kBgr24:
+      lookup_rgb<6>(row, frame.format == PixelFormat::kRgb24, classifier, out, count);
+      return;
+    case PixelFormat::kYuyv:
+    case PixelFormat::kNv12:
+    case PixelFormat::kYuv420: {
+      int16_t* py = px_y_.data();
+      int16_t* pu = px_u_.data();
+      int16_t* pv = px_v_.data();
+      if (frame.format == PixelFormat::kYuyv) {
+        yuyv_halved(row, py, pu, pv, count);
+      } else if (frame.format == PixelFormat::kNv12) {
+        planar_halved(row, frame.uv_row(y), frame.uv_row(y) + 1, 2, py, pu, pv, count);
+      } else {
+        planar_halved(row, frame.u_row(y), frame.v_row(y), 1, py, pu, pv, count);
+      }
+      bt601_levels(py, pu, pv, px_r_.data(), px_g_.data(), px_b_.data(), count);
+      lookup_levels(px_r_.data(), px_g_.data(), px_b_.data(), classifier, out, count);
+      return;
+    }
+    case PixelFormat::kGray8:
+    case PixelFormat::kMjpeg:
+      std::memset(out, 0, static_cast<size_t>(count));
+      return;
+  }
+}
+
+bool ComponentLabeler::label_halved(const ImageView& frame, const ColorClassifier& classifier) {
+  swept_.clear();
+  const SweepStart start = begin_sweep(frame);
+  if (start != SweepStart::kSweep) return start == SweepStart::kNoColour;
+  const int columns = (width_ + 1) / 2, rows = (height_ + 1) / 2;
+  run_budget_ =
+      std::min(max_runs_, std::max(1024, static_cast<int>(static_cast<double>(columns) * rows *
+                                                          params_.max_runs_per_pixel)));
+  // Rows apart are separate streams to the hardware prefetcher, which
+  // restarts at each: the rows ahead are asked for while this one is read.
+  for (int j = 0; j < std::min(rows, kHalvedRowsAhead); ++j)
+    prefetch_pixels(frame, 2 * j, 0, width_ - 1);
+  int prev_begin = 0, prev_end = 0;
+  for (int j = 0; j < rows; ++j) {
+    const int cur_begin = run_count_;
+    if (j + kHalvedRowsAhead < rows)
+      prefetch_pixels(frame, 2 * (j + kHalvedRowsAhead), 0, width_ - 1);
+    classify_halved_row(frame, 2 * j, columns, classifier);
+    swept_px_ += columns;
+    const bool ok = encode_row(j, 0, columns - 1);
+    std::memset(row_class_.data(), 0, static_cast<size_t>(columns));
+    if (!ok) return false;
+    join_row(cur_begin, &prev_begin, &prev_end);
+  }
+  accumulate(columns, rows);
+  for (size_t k = 0; k < comp_count_; ++k) {
+    Component& c = comps_[k];
+    c.area_px *= 4;
+    c.dark_px *= 4;
+    c.x_min *= 2;
+    c.y_min *= 2;
+    c.x_max = std::min(2 * c.x_max + 1, width_ - 1);
+    c.y_max = std::min(2 * c.y_max + 1, height_ - 1);
+    c.cx *= 2.0;
+    c.cy *= 2.0;
+    c.mu20 = 4.0 * c.mu20 + 0.25;
+    c.mu11 = 4.0 * c.mu11;
+    c.mu02 = 4.0 * c.mu02 + 0.25;
+  }
   return true;
 }
 

@@ -71,6 +71,16 @@ class ComponentLabeler {
   bool label(const ImageView& frame, const ColorClassifier& classifier,
              std::span<const PixelWindow> windows);
 
+  // The same over every other pixel of every other row (pixels (2i, 2j)), a
+  // quarter of the pixels, to find the markers when they are large enough
+  // to be seen so (Pipeline::process_halved). Components are given in the
+  // frame's pixels: centroid, extent, area and dark pixels scaled back, and
+  // the second moments those of the frame's pixel grid (+1/4 px²: a lattice
+  // of step s holds s²/12 less variance per axis than the region it
+  // samples). A blob on the sampled grid's last row or column touches the
+  // border. Hot path: no allocation.
+  bool label_halved(const ImageView& frame, const ColorClassifier& classifier);
+
   std::span<const Component> components() const { return {comps_.data(), comp_count_}; }
   int run_count() const { return run_count_; }
   // Pixels the last sweep classified.
@@ -91,15 +101,30 @@ class ComponentLabeler {
                      const ColorClassifier& classifier);
   void classify_yuv_span(const ImageView& frame, int y, int x0, int x1,
                          const ColorClassifier& classifier);
+  // Pixels (2i, y), i < count, into row_class_[i]: each pixel with its
+  // pair's own chroma (4:2:0: its chroma row's), no interpolation.
+  void classify_halved_row(const ImageView& frame, int y, int count,
+                           const ColorClassifier& classifier);
   // Row spans of every window, computed once per sweep (and, for a tracked
   // sweep, their pixels asked for); windows in the order of their left edges.
   void plan_spans(const ImageView& frame, std::span<const PixelWindow> windows, bool prefetch);
+  // A sweep's counts emptied; whether the frame is refused (another size,
+  // empty), has no colour to find (nothing to sweep) or is swept.
+  enum class SweepStart { kRefused, kNoColour, kSweep };
+  SweepStart begin_sweep(const ImageView& frame);
+  // Runs of row y's classes in [x0, x1]; false, and no runs, past the run
+  // budget.
   bool encode_row(int y, int x0, int x1);
+  bool abandon();  // no runs; false
+  // Joins the row just encoded (runs from cur_begin) to the one before,
+  // then makes it the one before.
+  void join_row(int cur_begin, int* prev_begin, int* prev_end);
   bool sweep_rows(const ImageView& frame, const ColorClassifier& classifier);
   void join_rows(int prev_begin, int prev_end, int cur_begin, int cur_end);
   int32_t find(int32_t i);
   void unite(int32_t a, int32_t b);
-  void accumulate();
+  // Components of the runs; the grid swept is width × height samples.
+  void accumulate(int width, int height);
 
   DetectorParams params_;
   int width_ = 0;

@@ -141,6 +141,14 @@ struct DetectorParams {
   // thesis's modes (axes, barycentric) sweep windows whatever it says: they
   // position from centroids (positions_from_centroids).
   bool track_edges = true;
+  // With the filter on, in a mode that positions from the edges: a frame
+  // swept whole finds its markers at half resolution (every other pixel of
+  // every other row) and measures them at their edges and dots as a
+  // tracked frame does, when its markers are large enough to be seen so
+  // (Pipeline::halved_sweep_suits); a frame that gives no pose so is swept
+  // again at full resolution. Without the filter (`locate`, the golden
+  // recordings) whole sweeps stay full resolution. See docs/pipeline_speed.md.
+  bool halve_whole_sweeps = true;
   int full_sweep_every = 30;
   // Window margin around a marker's predicted outline: this many pixels...
   float track_margin_px = 4.0f;

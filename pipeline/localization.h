@@ -51,6 +51,10 @@ struct Localization {
   // How the frame was swept: kNone tracked (windows only), else why whole
   // (a failed tracked sweep is followed by a whole one of the same frame).
   FullSweepReason sweep = FullSweepReason::kOff;
+  // Swept whole, its markers found at half resolution (Localizer,
+  // detector.halve_whole_sweeps); false when that gave no pose and the frame
+  // was swept again at full resolution.
+  bool halved = false;
   int64_t swept_px = 0;  // pixels classified, both sweeps of a failed track included
   std::array<int64_t, kStageCount> stage_ns{};  // duration of each pipeline stage
   int64_t localize_ns = 0;                      // whole localization, filter included

@@ -22,6 +22,7 @@ namespace ceilpose {
 // Frames swept by windows (tracked) and whole, by reason (FullSweepReason).
 struct SweepCounts {
   std::array<uint64_t, 7> by_reason{};  // index: FullSweepReason
+  uint64_t halved = 0;                  // of the whole ones: found at half resolution
   uint64_t tracked() const { return by_reason[0]; }
   uint64_t full() const {
     uint64_t n = 0;
@@ -76,6 +77,9 @@ class Localizer {
   std::unique_ptr<FrameResult> result_;  // ~50 kB: on the heap, allocated once
   Localization out_;
   bool had_fix_ = false;
+  // Frames swept whole are found at half resolution first
+  // (detector.halve_whole_sweeps, Pipeline::process_halved).
+  bool halved_sweeps_ = false;
   RefusalHistogram refusals_;
 
   // The filter's motion at this frame's time (predicted_) moved to the

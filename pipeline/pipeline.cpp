@@ -21,6 +21,10 @@ constexpr double kRecentreEdges_px = 1.0;
 // How far along North an edge-tracked marker's dots are sought from their
 // slots (a whole sweep: detector.dot_search_m, 1 in).
 constexpr double kTrackedDotSearch_m = 0.25 * kInch_m;
+// Smallest red dot, pixels at the nominal height, for a halved sweep: 2.5
+// samples at half resolution (a 640x480 frame's are 6-7 px, a 320x240
+// one's 3 px).
+constexpr double kHalvedSweepMinDot_px = 5.0;
 
 void check_size(const CameraIntrinsics& k) {
   if (k.width <= 0 || k.height <= 0) {
@@ -51,6 +55,10 @@ void Pipeline::set_config(const PipelineConfig& config) {
   labeler_ = ComponentLabeler(config.intrinsics.width, config.intrinsics.height, config.detector);
   model_ = make_rectangle_model(config.intrinsics, config.mount, config.layout);
   positioner_ = Positioner(config);
+}
+
+bool Pipeline::halved_sweep_suits() const {
+  return model_.px_per_m * config_.layout.red_dot_n_m >= kHalvedSweepMinDot_px;
 }
 
 const char* Pipeline::stage_name(int stage) {
@@ -160,7 +168,35 @@ bool edge_shift_px(const MarkerFrame& m, const RectangleEdges& red_edges,
   return true;
 }
 
+// The marker-frame rectangle an edge measurement reads: the outline and
+// the reach of its edges' profiles.
+double measured_half_e_m(const CeilingLayout& layout) {
+  return layout.rect_width_m + kEdgeProfileHalf_m;
+}
+double measured_half_n_m(const CeilingLayout& layout) {
+  return 0.5 * layout.rect_height_m + kEdgeProfileHalf_m;
+}
+
+// Whole: the marker's outline's corners project inside the frame.
+bool outline_inside(const ImageView& frame, const MarkerFrame& m, const CeilingLayout& layout) {
+  const double half_e_m = layout.rect_width_m, half_n_m = 0.5 * layout.rect_height_m;
+  for (double se : {-1.0, 1.0}) {
+    for (double sn : {-1.0, 1.0}) {
+      double u = 0.0, v = 0.0;
+      m.project(se * half_e_m, sn * half_n_m, &u, &v);
+      if (!(u >= 0.0 && v >= 0.0 && u <= frame.width - 1.0 && v <= frame.height - 1.0))
+        return false;
+    }
+  }
+  return true;
+}
+
 }  // namespace
+
+float Pipeline::pair_quality(const MarkerPair& pair) const {
+  return std::clamp(
+      1.0f - static_cast<float>(pair.score) / config_.detector.quality_zero_pair_score, 0.0f, 1.0f);
+}
 
 PairOutcome Pipeline::decode(const ImageView& frame, const MarkerPair& pair,
                              MarkerObservation* out) {
@@ -193,22 +229,10 @@ PairOutcome Pipeline::decode(const ImageView& frame, const MarkerPair& pair,
   o.green_u_px = green.cx;
   o.green_v_px = green.cy;
   o.west_image_rad = m.west_image_rad;
-  // Whole: the outline's corners project inside the frame.
-  bool whole = true;
-  const double half_e_m = layout.rect_width_m, half_n_m = 0.5 * layout.rect_height_m;
-  for (double se : {-1.0, 1.0}) {
-    for (double sn : {-1.0, 1.0}) {
-      double u = 0.0, v = 0.0;
-      m.project(se * half_e_m, sn * half_n_m, &u, &v);
-      whole = whole && u >= 0.0 && v >= 0.0 && u <= frame.width - 1.0 && v <= frame.height - 1.0;
-    }
-  }
-  o.whole = whole;
+  o.whole = outline_inside(frame, m, layout);
   const float margin = std::min(code_i.margin, code_j.margin);
   o.quality =
-      std::clamp(margin / config_.detector.quality_full_margin, 0.0f, 1.0f) *
-      std::clamp(1.0f - static_cast<float>(pair.score) / config_.detector.quality_zero_pair_score,
-                 0.0f, 1.0f);
+      std::clamp(margin / config_.detector.quality_full_margin, 0.0f, 1.0f) * pair_quality(pair);
   // Points for positioning: the centroids. Area centroids of the full
   // rectangles (dots folded in) are unbiased under the affine view of a level
   // camera, thresholding shifts opposite edges alike, and fit_rectangles has
@@ -221,27 +245,25 @@ PairOutcome Pipeline::decode(const ImageView& frame, const MarkerPair& pair,
   return PairOutcome::kDecoded;
 }
 
-// An edge-tracked marker: its edges and dots where the prediction puts it.
-// The codes read must be the predicted ones. Its rectangles' centres are
-// midway between their measured ends (where the prediction put them when an
-// end was not measured: they seed the fit and the consistency check, the
-// edge points alone position).
-PairOutcome Pipeline::measure_predicted(const ImageView& frame, const PredictedMarker& predicted,
-                                        MarkerObservation* out) {
+// A marker measured at its edges and dots around `m`, where a prediction or
+// a halved sweep's centroids put it: its codes are whatever the dots read
+// (callers check them). Its rectangles' centres are midway between their
+// measured ends (where `m` put them when an end was not measured: they seed
+// the fit and the consistency check, the edge points alone position).
+PairOutcome Pipeline::measure_at(const ImageView& frame, MarkerFrame m, MarkerObservation* out) {
   const CeilingLayout& layout = config_.layout;
-  MarkerFrame m = predicted.frame;
   RectangleEdges red_edges = measure_edges(frame, m, true, layout, EdgeLevels::kLinearLight);
   RectangleEdges green_edges = measure_edges(frame, m, false, layout, EdgeLevels::kLinearLight);
   // A profile measures its edge truly only near its middle: one that
   // crosses it off-centre takes part of the blurred rise (or a dot) for a
-  // plateau. When the marker lies more than kRecentreEdges_px from its
-  // prediction (a robot setting off from a pause: 4 px, 0.5 mm off), the
-  // edges are measured again around where they were found.
+  // plateau. When the marker lies more than kRecentreEdges_px from `m`
+  // (a robot setting off from a pause: 4 px, 0.5 mm off), the edges are
+  // measured again around where they were found.
   // Its edges must fix it both ways: ends alone leave it free along East,
-  // where nothing but the prediction would then place it (a prediction 8 px
-  // off put the pose 32 mm off, valid). Measured again, they must lie where
-  // they were found: otherwise the first profiles found something else.
-  // Either way the marker is refused rather than positioned with.
+  // where nothing but `m` would then place it (a prediction 8 px off put
+  // the pose 32 mm off, valid). Measured again, they must lie where they
+  // were found: otherwise the first profiles found something else. Either
+  // way the marker is refused rather than positioned with.
   double du = 0.0, dv = 0.0;
   if (!edge_shift_px(m, red_edges, green_edges, &du, &dv)) return PairOutcome::kInconsistent;
   if (std::hypot(du, dv) > kRecentreEdges_px) {
@@ -261,8 +283,6 @@ PairOutcome Pipeline::measure_predicted(const ImageView& frame, const PredictedM
       read_codes(frame, m, red_edges, std::min(config_.detector.dot_search_m, kTrackedDotSearch_m),
                  &code_i, &code_j);
   if (read != PairOutcome::kDecoded) return read;
-  if (code_i.code != predicted.code_i || code_j.code != predicted.code_j)
-    return PairOutcome::kInconsistent;
   MarkerObservation& o = *out;
   o.code_i = code_i.code;
   o.code_j = code_j.code;
@@ -279,12 +299,44 @@ PairOutcome Pipeline::measure_predicted(const ImageView& frame, const PredictedM
   o.centre_u_px = 0.5 * (o.red_u_px + o.green_u_px);
   o.centre_v_px = 0.5 * (o.red_v_px + o.green_v_px);
   o.west_image_rad = std::atan2(o.green_v_px - o.red_v_px, o.green_u_px - o.red_u_px);
-  o.whole = true;  // the plan's: inside the frame by the whole margin
+  o.whole = true;  // the plan's (inside by the margin); a halved sweep's: its own check
   o.quality = std::clamp(
       std::min(code_i.margin, code_j.margin) / config_.detector.quality_full_margin, 0.0f, 1.0f);
   o.point_count = 0;
   add_edge_points(red_edges, green_edges, &o);
   return PairOutcome::kDecoded;
+}
+
+// An edge-tracked marker: the codes read must be the predicted ones.
+PairOutcome Pipeline::measure_predicted(const ImageView& frame, const PredictedMarker& predicted,
+                                        MarkerObservation* out) {
+  const PairOutcome outcome = measure_at(frame, predicted.frame, out);
+  if (outcome != PairOutcome::kDecoded) return outcome;
+  if (out->code_i != predicted.code_i || out->code_j != predicted.code_j)
+    return PairOutcome::kInconsistent;
+  return outcome;
+}
+
+// A marker a halved sweep found: measured at its edges and dots as a
+// tracked one is, around where its centroids put it, and held to what a
+// whole sweep's decode checks (uncut, codes on the map's grid and agreeing
+// with the dark area, the pair's score in its quality).
+PairOutcome Pipeline::measure_found(const ImageView& frame, const MarkerPair& pair,
+                                    MarkerObservation* out) {
+  const RectangleCandidate& red = rects_[pair.red];
+  const RectangleCandidate& green = rects_[pair.green];
+  if (red.touches_border || green.touches_border) return PairOutcome::kCut;
+  const CeilingLayout& layout = config_.layout;
+  const MarkerFrame m = marker_frame(red, green, layout);
+  const PairOutcome outcome = measure_at(frame, m, out);
+  if (outcome != PairOutcome::kDecoded) return outcome;
+  const double px_per_m = std::hypot(m.north_u, m.north_v);
+  if (!dark_area_consistent(red, out->code_i, true, layout, px_per_m) ||
+      !dark_area_consistent(green, out->code_j, false, layout, px_per_m))
+    return PairOutcome::kInconsistent;
+  out->whole = outline_inside(frame, m, layout);
+  out->quality *= pair_quality(pair);
+  return outcome;
 }
 
 // With no marker decoded, the frame is refused for what stopped the pairs it
@@ -357,6 +409,29 @@ void Pipeline::position(PositioningMode mode, const CameraMotion& motion, FrameR
   clock->finish();
 }
 
+// 2. Rectangle template fit; 3. pairing, the red→green vector is West; 4.
+// each pair decoded by `decode_pair`; then reconcile and positioning.
+template <typename Decode>
+void Pipeline::finish_sweep(PositioningMode mode, const CameraMotion& motion, FrameResult* out,
+                            StageClock* clock, Decode decode_pair) {
+  rect_count_ =
+      static_cast<size_t>(fit_rectangles(labeler_.components(), model_, config_.detector, rects_));
+  clock->lap(kStageRectangles);
+  pair_count_ =
+      static_cast<size_t>(pairer_.pair(rectangles(), config_.layout, config_.detector, pairs_));
+  clock->lap(kStagePairing);
+  for (size_t k = 0; k < pair_count_; ++k) {
+    PairOutcome& outcome = pairs_[k].outcome;
+    outcome = out->marker_count == kMaxMarkersPerFrame
+                  ? PairOutcome::kOverflow
+                  : decode_pair(k, &out->markers[out->marker_count]);
+    out->rejects.count(outcome);
+    if (outcome == PairOutcome::kDecoded) ++out->marker_count;
+  }
+  clock->lap(kStageDecoding);
+  position(mode, motion, out, clock);
+}
+
 void Pipeline::process(const ImageView& frame, PositioningMode mode, FrameResult* out,
                        const CameraMotion& motion, std::span<const PixelWindow> windows) {
   StageClock clock(out);
@@ -369,28 +444,33 @@ void Pipeline::process(const ImageView& frame, PositioningMode mode, FrameResult
   out->window_cuts = labeler_.window_cut_count();
   out->swept_px = labeler_.swept_px();
   clock.lap(kStageComponents);
+  finish_sweep(mode, motion, out, &clock,
+               [&](size_t k, MarkerObservation* o) { return decode(frame, pairs_[k], o); });
+}
 
-  // 2. Rectangle template fit.
-  rect_count_ =
-      static_cast<size_t>(fit_rectangles(labeler_.components(), model_, config_.detector, rects_));
-  clock.lap(kStageRectangles);
-
-  // 3. Pair red with green; the red→green vector is West.
-  pair_count_ =
-      static_cast<size_t>(pairer_.pair(rectangles(), config_.layout, config_.detector, pairs_));
-  clock.lap(kStagePairing);
-
-  // 4. Read the dots, check the code against the geometry, emit points.
-  for (size_t k = 0; k < pair_count_; ++k) {
-    PairOutcome& outcome = pairs_[k].outcome;
-    outcome = out->marker_count == kMaxMarkersPerFrame
-                  ? PairOutcome::kOverflow
-                  : decode(frame, pairs_[k], &out->markers[out->marker_count]);
-    out->rejects.count(outcome);
-    if (outcome == PairOutcome::kDecoded) ++out->marker_count;
-  }
-  clock.lap(kStageDecoding);
-  position(mode, motion, out, &clock);
+void Pipeline::process_halved(const ImageView& frame, PositioningMode mode, FrameResult* out,
+                              const CameraMotion& motion) {
+  StageClock clock(out);
+  if (begin(frame, out) != Refusal::kNone) return clock.finish();
+  out->unit_gains = !classifier_.adapt(frame);
+  out->noisy = !labeler_.label_halved(frame, classifier_);
+  out->swept_px = labeler_.swept_px();
+  clock.lap(kStageComponents);
+  const double half_e_m = measured_half_e_m(config_.layout);
+  const double half_n_m = measured_half_n_m(config_.layout);
+  // Half the rows were read: each marker's image is asked for one marker
+  // ahead of its measuring, as a tracked frame's is.
+  auto ask = [&](size_t k) {
+    if (k >= pair_count_) return;
+    const MarkerFrame m =
+        marker_frame(rects_[pairs_[k].red], rects_[pairs_[k].green], config_.layout);
+    ask_marker_region(frame, m, -half_e_m, half_e_m, -half_n_m, half_n_m);
+  };
+  finish_sweep(mode, motion, out, &clock, [&](size_t k, MarkerObservation* o) {
+    if (k == 0) ask(0);
+    ask(k + 1);
+    return measure_found(frame, pairs_[k], o);
+  });
 }
 
 void Pipeline::process_tracked(const ImageView& frame, PositioningMode mode, FrameResult* out,
@@ -404,8 +484,8 @@ void Pipeline::process_tracked(const ImageView& frame, PositioningMode mode, Fra
   // follows the rows more than their length (a tracked 640×480 frame's
   // reading 17–22 % cheaper than asking for a square around the marker,
   // docs/pipeline_speed.md).
-  const double half_e_m = config_.layout.rect_width_m + kEdgeProfileHalf_m;
-  const double half_n_m = 0.5 * config_.layout.rect_height_m + kEdgeProfileHalf_m;
+  const double half_e_m = measured_half_e_m(config_.layout);
+  const double half_n_m = measured_half_n_m(config_.layout);
   auto ask = [&](size_t k) {
     if (k < predicted.size())
       ask_marker_region(frame, predicted[k].frame, -half_e_m, half_e_m, -half_n_m, half_n_m);

@@ -110,10 +110,24 @@ class Pipeline {
   void process_tracked(const ImageView& frame, PositioningMode mode, FrameResult* out,
                        const CameraMotion& motion, std::span<const PredictedMarker> predicted);
 
+  // A whole sweep that finds the markers at half resolution
+  // (ComponentLabeler::label_halved: a quarter of the pixels classified) and
+  // measures each at its edges and dots as an edge-tracked frame does, so
+  // that it positions from the edges alone (a mode that positions from
+  // centroids needs process()). For frames whose markers are large enough
+  // (halved_sweep_suits).
+  void process_halved(const ImageView& frame, PositioningMode mode, FrameResult* out,
+                      const CameraMotion& motion);
+
   // Replaces the configuration (SIGHUP reload of thresholds); rebuilds the
   // colour table and re-allocates only if the image size changed. Not in the
   // per-frame path.
   void set_config(const PipelineConfig& config);
+
+  // The configured camera sees a marker's red dots at least
+  // kHalvedSweepMinDot_px tall from the nominal height: at half resolution
+  // they still span samples enough to be folded into their rectangle.
+  bool halved_sweep_suits() const;
 
   static const char* stage_name(int stage);
 
@@ -135,8 +149,14 @@ class Pipeline {
                          const RectangleEdges& red_edges, double dot_search_m, CodeReading* code_i,
                          CodeReading* code_j) const;
   PairOutcome decode(const ImageView& frame, const MarkerPair& pair, MarkerObservation* out);
+  PairOutcome measure_at(const ImageView& frame, MarkerFrame m, MarkerObservation* out);
   PairOutcome measure_predicted(const ImageView& frame, const PredictedMarker& predicted,
                                 MarkerObservation* out);
+  PairOutcome measure_found(const ImageView& frame, const MarkerPair& pair, MarkerObservation* out);
+  float pair_quality(const MarkerPair& pair) const;
+  template <typename Decode>
+  void finish_sweep(PositioningMode mode, const CameraMotion& motion, FrameResult* out,
+                    StageClock* clock, Decode decode_pair);
   static Refusal refusal_without_markers(const FrameResult& result, size_t pair_count);
 
   PipelineConfig config_;

@@ -169,10 +169,13 @@ std::map<std::tuple<int, int, int>, double>& drive_median_ns() {
 }
 
 // The daemon's path on a moving robot (filter on), each frame swept whole
-// (tracking 0) or, with the fix, only in the predicted windows (1) or at the
-// predicted markers' edges and dots alone (2, detector.track_edges): thread CPU
-// time of Localizer::localize per frame, median over every frame of every
-// pass through the sequence (the filter restarts at each pass).
+// at full resolution (tracking 0) or, with the fix, only in the predicted
+// windows (1) or at the predicted markers' edges and dots alone (2,
+// detector.track_edges, the default: its whole sweeps at half resolution),
+// or each frame swept whole at half resolution (3,
+// detector.halve_whole_sweeps): thread CPU time of Localizer::localize per
+// frame, median over every frame of every pass through the sequence (the
+// filter restarts at each pass).
 // The camera formats BM_Drive's "format" argument indexes.
 constexpr PixelFormat kDriveFormats[] = {PixelFormat::kRgb24, PixelFormat::kYuyv,
                                          PixelFormat::kNv12};
@@ -181,15 +184,15 @@ void BM_Drive(benchmark::State& state) {
   const int width_px = static_cast<int>(state.range(0));
   const int format = static_cast<int>(state.range(1));
   const int tracking_mode = static_cast<int>(state.range(2));
-  const bool tracking = tracking_mode != 0;
   const std::vector<Image>& frames = drive_frames(width_px, kDriveFormats[format]);
   if (frames.size() != kDriveFrames) {
     state.SkipWithError("the drive set did not render");
     return;
   }
   PipelineConfig config = config_for(width_px);
-  config.detector.tracking = tracking;
-  config.detector.track_edges = tracking_mode == 2;
+  config.detector.tracking = tracking_mode == 1 || tracking_mode == 2;
+  config.detector.track_edges = tracking_mode >= 2;
+  config.detector.halve_whole_sweeps = tracking_mode >= 2;
   config = with_mode(config, PositioningMode::kAuto, true);
   auto localizer = std::make_unique<Localizer>(config);
   std::vector<double> frame_cpu_ns;
@@ -372,7 +375,7 @@ BENCHMARK(BM_Pipeline)
     ->Args({640, 25})
     ->Unit(benchmark::kMicrosecond);
 BENCHMARK(BM_Drive)
-    ->ArgsProduct({{320, 640, 1280}, {0, 1, 2}, {0, 1, 2}})
+    ->ArgsProduct({{320, 640, 1280}, {0, 1, 2}, {0, 1, 2, 3}})
     ->ArgNames({"width", "format", "tracking"})
     ->Unit(benchmark::kMicrosecond);
 BENCHMARK(BM_MjpegDecode)
@@ -402,8 +405,8 @@ void print_summary() {
   }
   if (drive_median_ns().empty()) return;
   std::printf("\ndrive set, filter on (medians of thread CPU time per frame, ms; x AprilTag d2)\n");
-  std::printf("%-10s %-6s %16s %16s %8s %16s %8s\n", "size", "pixels", "full sweeps", "tracked",
-              "ratio", "edges tracked", "ratio");
+  std::printf("%-10s %-6s %16s %16s %8s %16s %8s %16s %8s\n", "size", "pixels", "full sweeps",
+              "tracked", "ratio", "edges tracked", "ratio", "halved sweeps", "ratio");
   for (int width_px : {320, 640, 1280}) {
     for (int format : {0, 1, 2}) {
       const auto full = drive_median_ns().find({width_px, format, 0});
@@ -412,7 +415,7 @@ void print_summary() {
       const double tag_ns = tag == apriltag_median_ns().end() ? 0.0 : tag->second;
       std::printf("%4dx%-5d %-6s %7.3f (%5.1fx)", width_px, width_px * 3 / 4,
                   to_string(kDriveFormats[format]), full->second * 1e-6, tag_ns / full->second);
-      for (int mode : {1, 2}) {
+      for (int mode : {1, 2, 3}) {
         const auto tracked = drive_median_ns().find({width_px, format, mode});
         if (tracked == drive_median_ns().end()) {
           std::printf(" %16s %8s", "-", "-");
