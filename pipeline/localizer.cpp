@@ -84,10 +84,10 @@ const Localization& Localizer::localize(const ImageView& image, const FrameInfo&
   }
   if (sweep != FullSweepReason::kNone) {
     // A halved sweep stands when it gave a pose and measured at least two
-    // thirds of the pairs it found uncut. Under the stress levels, 2 frames
-    // of 16 had most of their markers blurred past their edges' profiles
-    // (2 measured, 7 refused), which a full sweep's decode reads; a wide
-    // angle lens refuses 3-4 of 12 at its corners either way.
+    // thirds of the pairs it found uncut. Under the stress levels, 1 frame
+    // of 16 had most of its markers blurred past their edges' profiles (2
+    // measured, 7 refused), which a full sweep's decode reads; a wide angle
+    // lens refuses 3-4 of 12 at its corners either way.
     if (halved_sweeps_) {
       pipeline_.process_halved(image, config.positioning.mode, result_.get(), motion);
       out_.swept_px += result_->swept_px;
