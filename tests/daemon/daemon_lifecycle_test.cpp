@@ -636,7 +636,7 @@ TEST_F(DaemonLifecycle, LogsWithJournalPrioritiesAndNoTimestampsWhenNotATerminal
 TEST_F(DaemonLifecycle, ASyntheticCameraInYuyvIsLocalizedAsAUsbCamerasFramesAre) {
   const std::string config =
       write_temp_file("ceilpose.yaml", config_text() + "capture:\n  pixel_format: yuyv\n");
-  auto r = run_daemon({"--config", config, "--shm", shm_, "--duration", "2", "--print-poses"});
+  auto r = run_daemon({"--config", config, "--shm", shm_, "--duration", "4", "--print-poses"});
   ASSERT_EQ(r.exit.code, ceilpose::kExitOk) << r.err;
   EXPECT_NE(r.err.find("synthetic 640x480 YUYV"), std::string::npos) << r.err;
   std::istringstream lines(r.out);
@@ -647,7 +647,7 @@ TEST_F(DaemonLifecycle, ASyntheticCameraInYuyvIsLocalizedAsAUsbCamerasFramesAre)
   }
   ASSERT_GE(errors_mm.size(), 5u) << r.out;
   std::sort(errors_mm.begin(), errors_mm.end());
-  // Measured: median 0.2 mm, max 0.6 mm over 29 poses (RGB: the same). The
+  // Measured: median 0.1 mm, max 0.3-0.4 mm over 38-39 poses in 4 s. The
   // synthetic renderer's aliased edges can put a frame ~7 mm off after a
   // marker row enters the view (docs/decisions.md), hence the looser max.
   EXPECT_LE(errors_mm[errors_mm.size() / 2], 0.5) << r.out;
@@ -655,15 +655,19 @@ TEST_F(DaemonLifecycle, ASyntheticCameraInYuyvIsLocalizedAsAUsbCamerasFramesAre)
 }
 
 TEST_F(DaemonLifecycle, PrintPosesShowsGroundTruthAndErrorForTheSyntheticSource) {
-  auto r = run_daemon({"--config", config_, "--shm", shm_, "--duration", "1.5", "--print-poses"});
+  // --duration counts from the daemon's start; under ASan on a loaded 2-core
+  // CI machine 1.5 s once passed before the first frame was processed.
+  constexpr double kDuration_s = 4.0;
+  auto r = run_daemon({"--config", config_, "--shm", shm_, "--duration",
+                       std::to_string(kDuration_s), "--print-poses"});
   ASSERT_EQ(r.exit.code, ceilpose::kExitOk) << r.err;
   std::istringstream lines(r.out);
   int with_truth = 0, total = 0;
   for (std::string line; std::getline(lines, line); ++total)
     with_truth +=
         line.find("truth x=") != std::string::npos && line.find(" err ") != std::string::npos;
-  EXPECT_GT(with_truth, 0) << r.out;
-  EXPECT_LE(total, 16) << "more than 10 lines a second";
+  EXPECT_GT(with_truth, 0) << r.out << r.err;
+  EXPECT_LE(total, 10 * kDuration_s + 1) << "more than 10 lines a second";
 }
 
 TEST_F(DaemonLifecycle, MissingReplayExitsFourWithoutCreatingTheSegment) {
