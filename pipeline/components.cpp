@@ -32,8 +32,8 @@ constexpr size_t kRowPadding = 8;
 // Windows side by side that a sweep's span table holds without growing
 // (a tracked frame has one per marker in view, a dozen).
 constexpr size_t kReservedSpansPerRow = 32;
-// Sampled rows a halved sweep asks for ahead of the one it reads.
-constexpr int kHalvedRowsAhead = 2;
+// Sampled rows a sampled sweep asks for ahead of the one it reads.
+constexpr int kSampledRowsAhead = 2;
 
 // x86-64's baseline (SSE2) has no 32-bit vector multiply, so the BT.601
 // arithmetic is also compiled for AVX2 and picked at load time where the
@@ -88,26 +88,29 @@ CEILPOSE_VECTOR_CLONES void interpolate_chroma(const int16_t* __restrict pair4,
   }
 }
 
-// Luma and chroma x16 of pixels 0, 2, 4, .. of a row: each pair's first
-// pixel with the pair's own chroma.
-CEILPOSE_VECTOR_CLONES void yuyv_halved(const uint8_t* __restrict q, int16_t* __restrict luma,
-                                        int16_t* __restrict u16, int16_t* __restrict v16, int n) {
+// Luma and chroma x16 of every `pairs`-th pixel pair's first pixel of a
+// row, with the pair's own chroma.
+CEILPOSE_VECTOR_CLONES void yuyv_sampled(const uint8_t* __restrict q, int pairs,
+                                         int16_t* __restrict luma, int16_t* __restrict u16,
+                                         int16_t* __restrict v16, int n) {
   for (int i = 0; i < n; ++i) {
-    luma[i] = q[4 * i];
-    u16[i] = static_cast<int16_t>(16 * q[4 * i + 1]);
-    v16[i] = static_cast<int16_t>(16 * q[4 * i + 3]);
+    const uint8_t* p = q + 4 * pairs * i;
+    luma[i] = p[0];
+    u16[i] = static_cast<int16_t>(16 * p[1]);
+    v16[i] = static_cast<int16_t>(16 * p[3]);
   }
 }
 // The same from 4:2:0 planes: chroma samples `step` bytes apart (NV12 2,
 // I420 1), the pixel's own chroma row.
-CEILPOSE_VECTOR_CLONES void planar_halved(const uint8_t* __restrict q, const uint8_t* __restrict u,
-                                          const uint8_t* __restrict v, int step,
-                                          int16_t* __restrict luma, int16_t* __restrict u16,
-                                          int16_t* __restrict v16, int n) {
+CEILPOSE_VECTOR_CLONES void planar_sampled(const uint8_t* __restrict q, int pairs,
+                                           const uint8_t* __restrict u, const uint8_t* __restrict v,
+                                           int step, int16_t* __restrict luma,
+                                           int16_t* __restrict u16, int16_t* __restrict v16,
+                                           int n) {
   for (int i = 0; i < n; ++i) {
-    luma[i] = q[2 * i];
-    u16[i] = static_cast<int16_t>(16 * u[step * i]);
-    v16[i] = static_cast<int16_t>(16 * v[step * i]);
+    luma[i] = q[2 * pairs * i];
+    u16[i] = static_cast<int16_t>(16 * u[step * pairs * i]);
+    v16[i] = static_cast<int16_t>(16 * v[step * pairs * i]);
   }
 }
 
@@ -563,14 +566,20 @@ bool ComponentLabeler::sweep_rows(const ImageView& frame, const ColorClassifier&
   return true;
 }
 
-void ComponentLabeler::classify_halved_row(const ImageView& frame, int y, int count,
-                                           const ColorClassifier& classifier) {
+void ComponentLabeler::classify_sampled_row(const ImageView& frame, int y, int step_px, int count,
+                                            const ColorClassifier& classifier) {
   const uint8_t* row = frame.row(y);
   uint8_t* out = row_class_.data();
+  const bool rgb = frame.format == PixelFormat::kRgb24;
+  const int pairs = step_px / 2;
   switch (frame.format) {
     case PixelFormat::kRgb24:
     case PixelFormat::kBgr24:
-      lookup_rgb<6>(row, frame.format == PixelFormat::kRgb24, classifier, out, count);
+      if (step_px == 4) {
+        lookup_rgb<12>(row, rgb, classifier, out, count);
+      } else {
+        lookup_rgb<6>(row, rgb, classifier, out, count);
+      }
       return;
     case PixelFormat::kYuyv:
     case PixelFormat::kNv12:
@@ -579,11 +588,11 @@ void ComponentLabeler::classify_halved_row(const ImageView& frame, int y, int co
       int16_t* pu = px_u_.data();
       int16_t* pv = px_v_.data();
       if (frame.format == PixelFormat::kYuyv) {
-        yuyv_halved(row, py, pu, pv, count);
+        yuyv_sampled(row, pairs, py, pu, pv, count);
       } else if (frame.format == PixelFormat::kNv12) {
-        planar_halved(row, frame.uv_row(y), frame.uv_row(y) + 1, 2, py, pu, pv, count);
+        planar_sampled(row, pairs, frame.uv_row(y), frame.uv_row(y) + 1, 2, py, pu, pv, count);
       } else {
-        planar_halved(row, frame.u_row(y), frame.v_row(y), 1, py, pu, pv, count);
+        planar_sampled(row, pairs, frame.u_row(y), frame.v_row(y), 1, py, pu, pv, count);
       }
       bt601_levels(py, pu, pv, px_r_.data(), px_g_.data(), px_b_.data(), count);
       lookup_levels(px_r_.data(), px_g_.data(), px_b_.data(), classifier, out, count);
@@ -596,24 +605,30 @@ void ComponentLabeler::classify_halved_row(const ImageView& frame, int y, int co
   }
 }
 
-bool ComponentLabeler::label_halved(const ImageView& frame, const ColorClassifier& classifier) {
+bool ComponentLabeler::label_sampled(const ImageView& frame, const ColorClassifier& classifier,
+                                     int step_px) {
   swept_.clear();
+  if (step_px != 2 && step_px != 4) {
+    begin_sweep(frame);
+    return false;
+  }
   const SweepStart start = begin_sweep(frame);
   if (start != SweepStart::kSweep) return start == SweepStart::kNoColour;
-  const int columns = (width_ + 1) / 2, rows = (height_ + 1) / 2;
+  const int s = step_px;
+  const int columns = (width_ + s - 1) / s, rows = (height_ + s - 1) / s;
   run_budget_ =
       std::min(max_runs_, std::max(1024, static_cast<int>(static_cast<double>(columns) * rows *
                                                           params_.max_runs_per_pixel)));
   // Rows apart are separate streams to the hardware prefetcher, which
   // restarts at each: the rows ahead are asked for while this one is read.
-  for (int j = 0; j < std::min(rows, kHalvedRowsAhead); ++j)
-    prefetch_pixels(frame, 2 * j, 0, width_ - 1);
+  for (int j = 0; j < std::min(rows, kSampledRowsAhead); ++j)
+    prefetch_pixels(frame, s * j, 0, width_ - 1);
   int prev_begin = 0, prev_end = 0;
   for (int j = 0; j < rows; ++j) {
     const int cur_begin = run_count_;
-    if (j + kHalvedRowsAhead < rows)
-      prefetch_pixels(frame, 2 * (j + kHalvedRowsAhead), 0, width_ - 1);
-    classify_halved_row(frame, 2 * j, columns, classifier);
+    if (j + kSampledRowsAhead < rows)
+      prefetch_pixels(frame, s * (j + kSampledRowsAhead), 0, width_ - 1);
+    classify_sampled_row(frame, s * j, s, columns, classifier);
     swept_px_ += columns;
     const bool ok = encode_row(j, 0, columns - 1);
     std::memset(row_class_.data(), 0, static_cast<size_t>(columns));
@@ -621,19 +636,22 @@ bool ComponentLabeler::label_halved(const ImageView& frame, const ColorClassifie
     join_row(cur_begin, &prev_begin, &prev_end);
   }
   accumulate(columns, rows);
+  // A lattice of step s holds (s² - 1)/12 px² less variance per axis than
+  // the frame's pixels of the region it samples.
+  const double lattice_var_px2 = (s * s - 1) / 12.0;
   for (size_t k = 0; k < comp_count_; ++k) {
     Component& c = comps_[k];
-    c.area_px *= 4;
-    c.dark_px *= 4;
-    c.x_min *= 2;
-    c.y_min *= 2;
-    c.x_max = std::min(2 * c.x_max + 1, width_ - 1);
-    c.y_max = std::min(2 * c.y_max + 1, height_ - 1);
-    c.cx *= 2.0;
-    c.cy *= 2.0;
-    c.mu20 = 4.0 * c.mu20 + 0.25;
-    c.mu11 = 4.0 * c.mu11;
-    c.mu02 = 4.0 * c.mu02 + 0.25;
+    c.area_px *= s * s;
+    c.dark_px *= s * s;
+    c.x_min *= s;
+    c.y_min *= s;
+    c.x_max = std::min(s * c.x_max + s - 1, width_ - 1);
+    c.y_max = std::min(s * c.y_max + s - 1, height_ - 1);
+    c.cx *= s;
+    c.cy *= s;
+    c.mu20 = s * s * c.mu20 + lattice_var_px2;
+    c.mu11 = s * s * c.mu11;
+    c.mu02 = s * s * c.mu02 + lattice_var_px2;
   }
   return true;
 }

@@ -71,15 +71,16 @@ class ComponentLabeler {
   bool label(const ImageView& frame, const ColorClassifier& classifier,
              std::span<const PixelWindow> windows);
 
-  // The same over every other pixel of every other row (pixels (2i, 2j)), a
-  // quarter of the pixels, to find the markers when they are large enough
-  // to be seen so (Pipeline::process_halved). Components are given in the
-  // frame's pixels: centroid, extent, area and dark pixels scaled back, and
-  // the second moments those of the frame's pixel grid (+1/4 px²: a lattice
-  // of step s holds s²/12 less variance per axis than the region it
-  // samples). A blob on the sampled grid's last row or column touches the
-  // border. Hot path: no allocation.
-  bool label_halved(const ImageView& frame, const ColorClassifier& classifier);
+  // The same over every step_px-th pixel of every step_px-th row (pixels
+  // (s·i, s·j), s 2 or 4, else false): 1/s² of the pixels, to find the
+  // markers when they are large enough to be seen so
+  // (Pipeline::process_halved). Components are given in the frame's
+  // pixels: centroid, extent, area and dark pixels scaled back, and the
+  // second moments those of the frame's pixel grid (+(s²−1)/12 px²: a
+  // lattice of step s holds that much less variance per axis than the
+  // region it samples). A blob on the sampled grid's last row or column
+  // touches the border. Hot path: no allocation.
+  bool label_sampled(const ImageView& frame, const ColorClassifier& classifier, int step_px);
 
   std::span<const Component> components() const { return {comps_.data(), comp_count_}; }
   int run_count() const { return run_count_; }
@@ -101,10 +102,10 @@ class ComponentLabeler {
                      const ColorClassifier& classifier);
   void classify_yuv_span(const ImageView& frame, int y, int x0, int x1,
                          const ColorClassifier& classifier);
-  // Pixels (2i, y), i < count, into row_class_[i]: each pixel with its
-  // pair's own chroma (4:2:0: its chroma row's), no interpolation.
-  void classify_halved_row(const ImageView& frame, int y, int count,
-                           const ColorClassifier& classifier);
+  // Pixels (step_px·i, y), i < count, into row_class_[i]: each pixel with
+  // its pair's own chroma (4:2:0: its chroma row's), no interpolation.
+  void classify_sampled_row(const ImageView& frame, int y, int step_px, int count,
+                            const ColorClassifier& classifier);
   // Row spans of every window, computed once per sweep (and, for a tracked
   // sweep, their pixels asked for); windows in the order of their left edges.
   void plan_spans(const ImageView& frame, std::span<const PixelWindow> windows, bool prefetch);

@@ -143,7 +143,8 @@ struct DetectorParams {
   bool track_edges = true;
   // With the filter on, in a mode that positions from the edges: a frame
   // swept whole finds its markers at half resolution (every other pixel of
-  // every other row) and measures them at their edges and dots as a
+  // every other row; every 4th of every 4th where red dots are >= 10 px,
+  // Pipeline::sweep_step_px) and measures them at their edges and dots as a
   // tracked frame does, when its markers are large enough to be seen so
   // (Pipeline::halved_sweep_suits); a frame that gives no pose so is swept
   // again at full resolution. Without the filter (`locate`, the golden

@@ -57,9 +57,14 @@ void Pipeline::set_config(const PipelineConfig& config) {
   positioner_ = Positioner(config);
 }
 
-bool Pipeline::halved_sweep_suits() const {
-  return model_.px_per_m * config_.layout.red_dot_n_m >= kHalvedSweepMinDot_px;
+int Pipeline::sweep_step_px() const {
+  const double red_dot_px = model_.px_per_m * config_.layout.red_dot_n_m;
+  return red_dot_px >= 2.0 * kHalvedSweepMinDot_px ? 4
+         : red_dot_px >= kHalvedSweepMinDot_px     ? 2
+                                                   : 1;
 }
+
+bool Pipeline::halved_sweep_suits() const { return sweep_step_px() > 1; }
 
 const char* Pipeline::stage_name(int stage) {
   switch (stage) {
@@ -453,7 +458,7 @@ void Pipeline::process_halved(const ImageView& frame, PositioningMode mode, Fram
   StageClock clock(out);
   if (begin(frame, out) != Refusal::kNone) return clock.finish();
   out->unit_gains = !classifier_.adapt(frame);
-  out->noisy = !labeler_.label_halved(frame, classifier_);
+  out->noisy = !labeler_.label_sampled(frame, classifier_, sweep_step_px());
   out->swept_px = labeler_.swept_px();
   clock.lap(kStageComponents);
   const double half_e_m = measured_half_e_m(config_.layout);

@@ -110,8 +110,9 @@ class Pipeline {
   void process_tracked(const ImageView& frame, PositioningMode mode, FrameResult* out,
                        const CameraMotion& motion, std::span<const PredictedMarker> predicted);
 
-  // A whole sweep that finds the markers at half resolution
-  // (ComponentLabeler::label_halved: a quarter of the pixels classified) and
+  // A whole sweep that finds the markers at half resolution, or a quarter
+  // where they are large (ComponentLabeler::label_sampled at
+  // sweep_step_px(): 1/4 or 1/16 of the pixels classified) and
   // measures each at its edges and dots as an edge-tracked frame does, so
   // that it positions from the edges alone (a mode that positions from
   // centroids needs process()). For frames whose markers are large enough
@@ -128,6 +129,10 @@ class Pipeline {
   // kHalvedSweepMinDot_px tall from the nominal height: at half resolution
   // they still span samples enough to be folded into their rectangle.
   bool halved_sweep_suits() const;
+  // The sampling step of a halved sweep: 2, or 4 where red dots are twice
+  // kHalvedSweepMinDot_px tall (1280x960: 13 px) and still span 3 samples;
+  // 1 where it does not suit.
+  int sweep_step_px() const;
 
   static const char* stage_name(int stage);
 

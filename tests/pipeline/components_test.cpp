@@ -227,36 +227,40 @@ TEST_F(ComponentsTest, YuvFramesClassifyEveryPixelAsItsBt601LevelsDo) {
   }
 }
 
-// Every other pixel of every other row, given back in the frame's pixels:
-// a 20 x 40 rectangle keeps its area and its second moments exactly (+1/4
-// px² restores the variance a lattice of step 2 does not hold), and its
-// centroid to the half pixel its sampling phase shifts it by.
-TEST_F(ComponentsTest, HalvedSweepGivesAreaMomentsAndCentroidInTheFramesPixels) {
-  for (int x0 : {10, 11}) {
-    SCOPED_TRACE(x0);
-    fill(0, 0, kWidth - 1, kHeight - 1, layout.tile);
-    fill(x0, 20, x0 + 19, 59, kRed);
-    fill(x0 + 8, 36, x0 + 11, 41, kDot);  // a dot: 2 x 3 samples, folded in
-    ASSERT_TRUE(labeler.label_halved(frame.view(), classifier));
-    const auto comps = labeler.components();
-    ASSERT_EQ(comps.size(), 1u);
-    const Component& c = comps[0];
-    EXPECT_EQ(c.cls, PixelClass::kRed);
-    EXPECT_EQ(c.area_px, 800);
-    EXPECT_EQ(c.dark_px, 24);
-    EXPECT_NEAR(c.cx, x0 + 9.5, 0.5 + 1e-9);
-    EXPECT_NEAR(c.cy, 39.5, 0.5 + 1e-9);
-    EXPECT_NEAR(c.mu20, (20.0 * 20.0 - 1.0) / 12.0, 1e-9);
-    EXPECT_NEAR(c.mu02, (40.0 * 40.0 - 1.0) / 12.0, 1e-9);
-    EXPECT_NEAR(c.mu11, 0.0, 1e-9);
-    EXPECT_FALSE(c.touches_border);
-    EXPECT_EQ(labeler.swept_px(), (kWidth / 2) * (kHeight / 2));
+// Every other pixel of every other row (or every 4th of every 4th, for
+// large markers at 1280x960), given back in the frame's pixels: a 20 x 40
+// rectangle keeps its area and its second moments exactly (+(s²-1)/12 px²
+// restores the variance a lattice of step s does not hold), and its
+// centroid to the (s-1)/2 px its sampling phase shifts it by, at every phase.
+TEST_F(ComponentsTest, SampledSweepGivesAreaMomentsAndCentroidInTheFramesPixels) {
+  for (int step : {2, 4}) {
+    for (int x0 = 8; x0 < 8 + step; ++x0) {
+      SCOPED_TRACE(testing::Message() << "step " << step << " x0 " << x0);
+      fill(0, 0, kWidth - 1, kHeight - 1, layout.tile);
+      fill(x0, 20, x0 + 19, 59, kRed);
+      fill(x0 + 8, 36, x0 + 11, 41, kDot);  // a 4 x 6 dot, folded in
+      ASSERT_TRUE(labeler.label_sampled(frame.view(), classifier, step));
+      const auto comps = labeler.components();
+      ASSERT_EQ(comps.size(), 1u);
+      const Component& c = comps[0];
+      EXPECT_EQ(c.cls, PixelClass::kRed);
+      EXPECT_EQ(c.area_px, 800);
+      EXPECT_EQ(c.dark_px, step == 2 ? 24 : 32);  // 2 x 3 or 1 x 2 samples
+      EXPECT_NEAR(c.cx, x0 + 9.5, 0.5 * (step - 1) + 1e-9);
+      EXPECT_NEAR(c.cy, 39.5, 0.5 * (step - 1) + 1e-9);
+      EXPECT_NEAR(c.mu20, (20.0 * 20.0 - 1.0) / 12.0, 1e-9);
+      EXPECT_NEAR(c.mu02, (40.0 * 40.0 - 1.0) / 12.0, 1e-9);
+      EXPECT_NEAR(c.mu11, 0.0, 1e-9);
+      EXPECT_FALSE(c.touches_border);
+      EXPECT_EQ(labeler.swept_px(), ((kWidth + step - 1) / step) * ((kHeight + step - 1) / step));
+    }
   }
+  EXPECT_FALSE(labeler.label_sampled(frame.view(), classifier, 3)) << "steps are 2 or 4";
 }
 
 TEST_F(ComponentsTest, HalvedSweepFlagsTheLastSampledRowAndColumnAsBorder) {
   fill(100, 30, kWidth - 1, 50, kGreen);  // sampled up to column 118
-  ASSERT_TRUE(labeler.label_halved(frame.view(), classifier));
+  ASSERT_TRUE(labeler.label_sampled(frame.view(), classifier, 2));
   ASSERT_EQ(labeler.components().size(), 1u);
   EXPECT_TRUE(labeler.components()[0].touches_border);
   EXPECT_EQ(labeler.components()[0].x_max, kWidth - 1);
@@ -271,13 +275,13 @@ TEST_F(ComponentsTest, HalvedSweepOfYuvFramesGivesTheRgbFramesRectangles) {
   fill(10, 20, 29, 59, kRed);
   fill(61, 11, 84, 40, kGreen);
   fill(66, 20, 71, 25, kDot);
-  ASSERT_TRUE(labeler.label_halved(frame.view(), classifier));
+  ASSERT_TRUE(labeler.label_sampled(frame.view(), classifier, 2));
   const std::vector<Component> want(labeler.components().begin(), labeler.components().end());
   ASSERT_EQ(want.size(), 2u);
   for (PixelFormat format : {PixelFormat::kYuyv, PixelFormat::kNv12, PixelFormat::kYuv420}) {
     SCOPED_TRACE(to_string(format));
     const Image yuv = test::convert_rgb(frame, format);
-    ASSERT_TRUE(labeler.label_halved(yuv.view(), classifier));
+    ASSERT_TRUE(labeler.label_sampled(yuv.view(), classifier, 2));
     const auto got = labeler.components();
     ASSERT_EQ(got.size(), want.size());
     for (size_t k = 0; k < want.size(); ++k) {
@@ -292,14 +296,14 @@ TEST_F(ComponentsTest, HalvedSweepOfYuvFramesGivesTheRgbFramesRectangles) {
 TEST_F(ComponentsTest, HalvedSweepRefusesNoiseAnotherSizeAndFindsNothingInGrey) {
   fill(10, 20, 29, 59, kRed);
   const Image grey = test::convert_rgb(frame, PixelFormat::kGray8);
-  EXPECT_TRUE(labeler.label_halved(grey.view(), classifier));
+  EXPECT_TRUE(labeler.label_sampled(grey.view(), classifier, 2));
   EXPECT_TRUE(labeler.components().empty());
   Image other(kWidth + 2, kHeight, PixelFormat::kRgb24);
-  EXPECT_FALSE(labeler.label_halved(other.view(), classifier));
+  EXPECT_FALSE(labeler.label_sampled(other.view(), classifier, 2));
   std::mt19937 rng(3);
   for (int y = 0; y < kHeight; ++y)
     for (int x = 0; x < kWidth; ++x) test::put_rgb(&frame, x, y, (rng() & 1) ? kRed : kGreen);
-  EXPECT_FALSE(labeler.label_halved(frame.view(), classifier));
+  EXPECT_FALSE(labeler.label_sampled(frame.view(), classifier, 2));
   EXPECT_TRUE(labeler.components().empty());
 }
 

@@ -126,14 +126,20 @@ Image blur_rows(const Image& rgb, int length_px) {
   return out;
 }
 
-CameraIntrinsics half_size_camera() {
+// The default camera scaled: pixel centres map to pixel centres.
+CameraIntrinsics scaled_default_camera(double scale) {
   CameraIntrinsics k;
-  k.width = 320;
-  k.height = 240;
-  k.fx = k.fy = 265.0;
-  k.cx = 159.5;
-  k.cy = 119.5;
+  k.width = static_cast<int>(k.width * scale);
+  k.height = static_cast<int>(k.height * scale);
+  k.fx *= scale;
+  k.fy *= scale;
+  k.cx = (k.cx + 0.5) * scale - 0.5;
+  k.cy = (k.cy + 0.5) * scale - 0.5;
   return k;
 }
+
+CameraIntrinsics half_size_camera() { return scaled_default_camera(0.5); }
+
+CameraIntrinsics double_size_camera() { return scaled_default_camera(2.0); }
 
 }  // namespace ceilpose::test

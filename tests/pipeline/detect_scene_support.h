@@ -42,6 +42,8 @@ Image blur_rows(const Image& rgb, int length_px);
 
 // The default camera at half resolution (320 × 240, same field of view).
 CameraIntrinsics half_size_camera();
+// The same at 1280x960 (fx = fy 1060): red dots of 13 px.
+CameraIntrinsics double_size_camera();
 
 // Pixel (x, y) of an RGB24 image set to (r, g, b).
 void put_rgb(Image* image, int x, int y, Rgb colour);

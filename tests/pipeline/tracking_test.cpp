@@ -581,6 +581,17 @@ TEST(TrackedLocalizer, EdgeTrackedFramesOfAWideAngleOffCentreCamera) {
   expect_tracking_changes_nothing(c, 0.4, kEdgeLimits);
 }
 
+// A 1280x960 camera (fx 1060): its whole sweeps find the markers at every
+// 4th pixel of every 4th row. Measured (2026-12-06, 60 frames): 36
+// tracked, all 24 whole sweeps at the quarter step, every frame valid both
+// ways; largest difference from the full-resolution sweep 0.194 mm, p99
+// 0.222 -> 0.130 mm, the tracked frames' median 0.079 -> 0.058 mm.
+TEST(TrackedLocalizer, EdgeTrackedYuyvFramesOfA1280x960Camera) {
+  const XCamera camera{1280, 960, 1060.0, 1060.0, 639.5, 479.5, {}};
+  const Compared c = compare(testing::accuracy_frames(60), PixelFormat::kYuyv, camera, true);
+  expect_tracking_changes_nothing(c, 0.55, kEdgeLimits);
+}
+
 TEST(TrackedLocalizer, GreyFramesNeverTrackAndGiveNoPose) {
   const Compared c = compare(testing::accuracy_frames(10), PixelFormat::kGray8);
   EXPECT_EQ(c.tracked, 0);
