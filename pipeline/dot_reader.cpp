@@ -5,6 +5,7 @@
 #include <cmath>
 #include <numbers>
 
+#include "core/int_rounding.h"
 #include "core/pixel_read.h"
 #include "pipeline/color_classifier.h"
 
@@ -36,7 +37,7 @@ namespace {
 using Brightness = std::array<double, 2>;
 
 Brightness brightness_at(const ImageView& frame, double u, double v) {
-  const int x0 = static_cast<int>(std::floor(u)), y0 = static_cast<int>(std::floor(v));
+  const int x0 = floor_int(u), y0 = floor_int(v);
   if (x0 < 0 || y0 < 0 || x0 + 1 >= frame.width || y0 + 1 >= frame.height) return {-1.0, -1.0};
   const double fu = u - x0, fv = v - y0;
   const double w[4] = {(1 - fu) * (1 - fv), fu * (1 - fv), (1 - fu) * fv, fu * fv};
@@ -109,8 +110,22 @@ MarkerRegion::MarkerRegion(const MarkerFrame& marker, double e0_m, double e1_m, 
   // inverse.
   const double e_per_du = marker.north_v / det, e_per_dv = -marker.north_u / det;
   const double n_per_du = -marker.east_v / det, n_per_dv = marker.east_u / det;
-  bounds_[0] = {e_per_dv, e_per_du == 0.0 ? 0.0 : 1.0 / e_per_du, e0_m, e1_m};
-  bounds_[1] = {n_per_dv, n_per_du == 0.0 ? 0.0 : 1.0 / n_per_du, n0_m, n1_m};
+  // Along a row, a coordinate at m_per_dv·dv + m_per_du·du lies within
+  // [lo_m, hi_m] for du between (lo_m − m_per_dv·dv)/m_per_du and
+  // (hi_m − m_per_dv·dv)/m_per_du, in the order of m_per_du's sign.
+  auto bound = [](double m_per_dv, double m_per_du, double lo_m, double hi_m) {
+    Bound b;
+    b.per_row_m = m_per_dv, b.lo_m = lo_m, b.hi_m = hi_m;
+    b.along_row = m_per_du != 0.0;
+    if (!b.along_row) return b;
+    const double px_per_m = 1.0 / m_per_du;
+    b.lo_px = (m_per_du > 0.0 ? lo_m : hi_m) * px_per_m;
+    b.hi_px = (m_per_du > 0.0 ? hi_m : lo_m) * px_per_m;
+    b.slope = -m_per_dv * px_per_m;
+    return b;
+  };
+  bounds_[0] = bound(e_per_dv, e_per_du, e0_m, e1_m);
+  bounds_[1] = bound(n_per_dv, n_per_du, n0_m, n1_m);
   double v_min = INFINITY, v_max = -INFINITY;
   for (double e_m : {e0_m, e1_m}) {
     for (double n_m : {n0_m, n1_m}) {
@@ -130,19 +145,19 @@ PixelSpan MarkerRegion::row(int y) const {
   const double dv = y - marker_.centre_v_px;
   double du_lo = -INFINITY, du_hi = INFINITY;
   for (const Bound& b : bounds_) {
-    const double at_m = dv * b.per_row_m;
-    if (b.px_per_m == 0.0) {
+    if (!b.along_row) {
+      const double at_m = dv * b.per_row_m;
       if (at_m < b.lo_m || at_m > b.hi_m) return {};
       continue;
     }
-    const double a = (b.lo_m - at_m) * b.px_per_m, c = (b.hi_m - at_m) * b.px_per_m;
-    du_lo = std::max(du_lo, std::min(a, c));
-    du_hi = std::min(du_hi, std::max(a, c));
+    du_lo = std::max(du_lo, b.lo_px + dv * b.slope);
+    du_hi = std::min(du_hi, b.hi_px + dv * b.slope);
   }
   PixelSpan out;
   if (!(du_lo <= du_hi)) return out;
-  out.x0 = static_cast<int>(std::max(0.0, std::floor(marker_.centre_u_px + du_lo)));
-  out.x1 = static_cast<int>(std::min(width_ - 1.0, std::ceil(marker_.centre_u_px + du_hi)));
+  // Clamped first: a span beyond the frame comes out empty (x0 > x1).
+  out.x0 = floor_int(std::clamp(marker_.centre_u_px + du_lo, 0.0, static_cast<double>(width_)));
+  out.x1 = ceil_int(std::clamp(marker_.centre_u_px + du_hi, -1.0, width_ - 1.0));
   return out;
 }
 

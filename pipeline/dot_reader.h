@@ -44,11 +44,15 @@ class MarkerRegion {
   PixelSpan row(int y) const;
 
  private:
-  // One of the rectangle's two coordinates (e, n): dv·per_row_m at the
-  // centre's column of the row dv below the centre, changing 1/px_per_m
-  // per pixel along the row (px_per_m 0: not at all); within [lo_m, hi_m].
+  // One of the rectangle's two coordinates (e, n) within its limits, on
+  // the row dv below the centre: where it changes along the row, the
+  // columns du (from the centre's) lo_px + dv·slope ≤ du ≤ hi_px +
+  // dv·slope; where it does not (along_row false), every column or none,
+  // as dv·per_row_m lies within [lo_m, hi_m] or not.
   struct Bound {
-    double per_row_m = 0.0, px_per_m = 0.0, lo_m = 0.0, hi_m = 0.0;
+    bool along_row = true;
+    double lo_px = 0.0, hi_px = 0.0, slope = 0.0;
+    double per_row_m = 0.0, lo_m = 0.0, hi_m = 0.0;
   };
   MarkerFrame marker_;
   std::array<Bound, 2> bounds_{};

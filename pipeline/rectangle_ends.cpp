@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "core/int_rounding.h"
 #include "core/pixel_read.h"
 
 namespace ceilpose {
@@ -45,7 +46,7 @@ const std::array<float, 256>& linear_of_level() {
 // The darkest channel's level (0–255) at (u, v), bilinear: red and green
 // print far below the tile in it. False outside the frame.
 bool darkest_at(const ImageView& frame, double u, double v, double* level) {
-  const int x0 = static_cast<int>(std::floor(u)), y0 = static_cast<int>(std::floor(v));
+  const int x0 = floor_int(u), y0 = floor_int(v);
   if (x0 < 0 || y0 < 0 || x0 + 1 >= frame.width || y0 + 1 >= frame.height) return false;
   const double fu = u - x0, fv = v - y0;
   std::array<uint8_t, 4> c;
@@ -108,16 +109,79 @@ bool read_fitted_profile(const ImageView& frame, const MarkerFrame& marker, doub
   return true;
 }
 
+// A frame whose edge level is one byte of each pixel: a channel of RGB or
+// BGR, a YUV frame's luma, grey. Its level (0–255; YUV luma to full range)
+// and linear light come from tables of that byte.
+struct BytePlane {
+  const uint8_t* first = nullptr;  // pixel (0, 0)'s byte
+  ptrdiff_t pixel_bytes = 0, row_bytes = 0;
+  const std::array<double, 256>* level = nullptr;
+  const std::array<float, 256>* linear = nullptr;
+};
+
+template <bool kYuvLuma>
+const BytePlane& byte_tables() {
+  static const BytePlane tables = [] {
+    static std::array<double, 256> level{};
+    static std::array<float, 256> linear{};
+    for (int i = 0; i < 256; ++i) {
+      const uint8_t l = kYuvLuma ? yuv_channel(yuv_luma_part(i), 0) : static_cast<uint8_t>(i);
+      level[static_cast<size_t>(i)] = l;
+      linear[static_cast<size_t>(i)] = linear_of_level()[l];
+    }
+    BytePlane t;
+    t.level = &level;
+    t.linear = &linear;
+    return t;
+  }();
+  return tables;
+}
+
+// False where the level is not one byte (RGB whose chroma was halved gives
+// its luma, computed from three; MJPEG has no pixels).
+bool byte_plane(const ImageView& frame, EdgeChannel channel, BytePlane* out) {
+  const int rgb_offset = channel == EdgeChannel::kRed ? 0 : 1;
+  int offset = 0;
+  switch (frame.format) {
+    case PixelFormat::kRgb24:
+    case PixelFormat::kBgr24:
+      if (channel == EdgeChannel::kLuma) return false;
+      *out = byte_tables<false>();
+      out->pixel_bytes = 3;
+      offset = frame.format == PixelFormat::kRgb24 ? rgb_offset : 2 - rgb_offset;
+      break;
+    case PixelFormat::kYuyv:
+    case PixelFormat::kNv12:
+    case PixelFormat::kYuv420:
+      *out = byte_tables<true>();
+      out->pixel_bytes = frame.format == PixelFormat::kYuyv ? 2 : 1;
+      break;
+    case PixelFormat::kGray8:
+      *out = byte_tables<false>();
+      out->pixel_bytes = 1;
+      break;
+    case PixelFormat::kMjpeg:
+      return false;
+  }
+  out->first = frame.data + offset;
+  out->row_bytes = frame.stride_bytes;
+  return true;
+}
+
 // The same for a kLinearLight profile over axis_steps, and its linear
 // light. Each step moves one whole pixel along the dominant axis, so the
 // bilinear weights along it are the same for every sample: the profile is
-// stepped rather than projected, and its format dispatched once (a tracked
-// 640×480 drive frame's measuring, warm: RGB 87 → 58 µs, YUYV 99 → 82 µs).
-// False when a sample leaves the frame.
-template <PixelFormat F>
+// stepped rather than projected (a tracked 640×480 drive frame's
+// measuring, warm: RGB 87 → 58 µs, YUYV 99 → 82 µs). `quad(u_major, a, b)`
+// gives the edge levels' bytes at (major, minor) (a, b), (a + 1, b),
+// (a, b + 1), (a + 1, b + 1); `level_of` and `linear_of` their level and
+// linear light. False when a sample leaves the frame.
+template <typename Quad>
 bool read_axis_profile(const ImageView& frame, const MarkerFrame& marker, double e_m, double n_m,
-                       double de, double dn, const ProfileSteps& steps, EdgeChannel channel,
-                       double* level, double* edge) {
+                       double de, double dn, const ProfileSteps& steps,
+                       const std::array<double, 256>& level_of,
+                       const std::array<float, 256>& linear_of, Quad quad, double* level,
+                       double* edge) {
   const double du_per_m = de * marker.east_u + dn * marker.north_u;
   const double dv_per_m = de * marker.east_v + dn * marker.north_v;
   const bool u_major = std::abs(du_per_m) >= std::abs(dv_per_m);
@@ -129,24 +193,56 @@ bool read_axis_profile(const ImageView& frame, const MarkerFrame& marker, double
   const int major_step = (u_major ? du_per_m : dv_per_m) > 0.0 ? 1 : -1;
   const int major_limit = u_major ? frame.width : frame.height;
   const int minor_limit = u_major ? frame.height : frame.width;
-  int a = static_cast<int>(std::floor(major));
+  int a = floor_int(major);
   const double fa = major - a;
-  auto read = [&](int major_px, int minor_px) {
-    return u_major ? pixel_edge_level<F>(frame, major_px, minor_px, channel)
-                   : pixel_edge_level<F>(frame, minor_px, major_px, channel);
-  };
-  const auto& lin = linear_of_level();
   for (int k = 0; k < steps.samples; ++k, a += major_step, minor += minor_step) {
-    const int b = static_cast<int>(std::floor(minor));
+    const int b = floor_int(minor);
     if (a < 0 || a + 1 >= major_limit || b < 0 || b + 1 >= minor_limit) return false;
     const double fb = minor - b;
-    const uint8_t c00 = read(a, b), c10 = read(a + 1, b);
-    const uint8_t c01 = read(a, b + 1), c11 = read(a + 1, b + 1);
-    level[k] = (1 - fb) * ((1 - fa) * c00 + fa * c10) + fb * ((1 - fa) * c01 + fa * c11);
-    edge[k] = (1 - fb) * ((1 - fa) * lin[c00] + fa * lin[c10]) +
-              fb * ((1 - fa) * lin[c01] + fa * lin[c11]);
+    const auto [c00, c10, c01, c11] = quad(u_major, a, b);
+    level[k] = (1 - fb) * ((1 - fa) * level_of[c00] + fa * level_of[c10]) +
+               fb * ((1 - fa) * level_of[c01] + fa * level_of[c11]);
+    edge[k] = (1 - fb) * ((1 - fa) * linear_of[c00] + fa * linear_of[c10]) +
+              fb * ((1 - fa) * linear_of[c01] + fa * linear_of[c11]);
   }
   return true;
+}
+
+// A kLinearLight profile's levels: from a byte plane, four bytes at fixed
+// offsets per sample; else (RGB whose chroma was halved: its luma) each
+// pixel's level computed.
+bool read_linear_profile(const ImageView& frame, const MarkerFrame& marker, double e_m, double n_m,
+                         double de, double dn, const ProfileSteps& steps, EdgeChannel channel,
+                         double* level, double* edge) {
+  if (BytePlane plane; byte_plane(frame, channel, &plane)) {
+    return read_axis_profile(
+        frame, marker, e_m, n_m, de, dn, steps, *plane.level, *plane.linear,
+        [&](bool u_major, int a, int b) {
+          const ptrdiff_t major_bytes = u_major ? plane.pixel_bytes : plane.row_bytes;
+          const ptrdiff_t minor_bytes = u_major ? plane.row_bytes : plane.pixel_bytes;
+          const uint8_t* p = plane.first + a * major_bytes + b * minor_bytes;
+          return std::array<uint8_t, 4>{p[0], p[major_bytes], p[minor_bytes],
+                                        p[major_bytes + minor_bytes]};
+        },
+        level, edge);
+  }
+  const BytePlane& identity = byte_tables<false>();
+  bool inside = false;
+  with_pixel_format(frame.format, [&](auto tag) {
+    constexpr PixelFormat F = decltype(tag)::value;
+    inside = read_axis_profile(
+        frame, marker, e_m, n_m, de, dn, steps, *identity.level, *identity.linear,
+        [&](bool u_major, int a, int b) {
+          auto read = [&](int major_px, int minor_px) {
+            return u_major ? pixel_edge_level<F>(frame, major_px, minor_px, channel)
+                           : pixel_edge_level<F>(frame, minor_px, major_px, channel);
+          };
+          return std::array<uint8_t, 4>{read(a, b), read(a + 1, b), read(a, b + 1),
+                                        read(a + 1, b + 1)};
+        },
+        level, edge);
+  });
+  return inside;
 }
 
 // One profile through marker point (e_m, n_m) on the edge along the unit
@@ -165,26 +261,30 @@ bool profile(const ImageView& frame, const MarkerFrame& marker, double e_m, doub
     inside = read_fitted_profile(frame, marker, e_m, n_m, de, dn, steps, level.data());
     edge = level;
   } else {
-    with_pixel_format(frame.format, [&](auto tag) {
-      inside = read_axis_profile<decltype(tag)::value>(frame, marker, e_m, n_m, de, dn, steps,
-                                                       channel, level.data(), edge.data());
-    });
+    inside = read_linear_profile(frame, marker, e_m, n_m, de, dn, steps, channel, level.data(),
+                                 edge.data());
   }
   if (!inside) return false;
   const double low = 0.5 * (level[0] + level[1]);
   const double high = 0.5 * (level[samples - 1] + level[samples - 2]);
   if (high - low < kMinContrast) return false;
-  auto crossing = [&](double fraction) {
-    const double target = low + fraction * (high - low);
-    for (int k = 1; k < samples; ++k) {
-      if (level[k] >= target && level[k - 1] < target)
-        return -steps.half_m +
-               ((k - 1) + (target - level[k - 1]) / (level[k] - level[k - 1])) * step_m;
+  // The first upward crossing of each of 25, 50 and 75 % of the rise, in
+  // one pass.
+  constexpr std::array<double, 3> kFractions{0.25, 0.5, 0.75};
+  std::array<double, 3> at{NAN, NAN, NAN};
+  int pending = 3;
+  for (int k = 1; k < samples && pending > 0; ++k) {
+    for (size_t i = 0; i < kFractions.size(); ++i) {
+      const double target = low + kFractions[i] * (high - low);
+      if (std::isnan(at[i]) && level[k] >= target && level[k - 1] < target) {
+        at[i] = -steps.half_m +
+                ((k - 1) + (target - level[k - 1]) / (level[k] - level[k - 1])) * step_m;
+        --pending;
+      }
     }
-    return static_cast<double>(NAN);
-  };
-  out->at25 = crossing(0.25);
-  out->at75 = crossing(0.75);
+  }
+  out->at25 = at[0];
+  out->at75 = at[2];
   // The edge: where a sharp step with the profile's area would be (the
   // rise's shortfall summed from the inner end), so every sample counts
   // rather than the two around the half-way level: on tilted independent
@@ -193,7 +293,7 @@ bool profile(const ImageView& frame, const MarkerFrame& marker, double e_m, doub
   // ceiling: a clipped rise is no longer symmetric about the edge, and its
   // shift varies with the edge's angle (a level frame of a +1.9 EV
   // render chose a tilt and was 2.8 mm off).
-  if (std::isnan(crossing(0.5)) || high >= kClipLevel) return true;
+  if (std::isnan(at[1]) || high >= kClipLevel) return true;
   // Under kLinearLight the area is summed in linear light: a pixel
   // straddling the edge holds the area-weighted mean of the two sides'
   // light, which its sRGB level does not (half covered, it reads ~70 % of
