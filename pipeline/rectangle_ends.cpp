@@ -270,12 +270,13 @@ bool profile(const ImageView& frame, const MarkerFrame& marker, double e_m, doub
   if (high - low < kMinContrast) return false;
   // The first upward crossing of each of 25, 50 and 75 % of the rise, in
   // one pass.
-  constexpr std::array<double, 3> kFractions{0.25, 0.5, 0.75};
+  const std::array<double, 3> targets{low + 0.25 * (high - low), low + 0.5 * (high - low),
+                                      low + 0.75 * (high - low)};
   std::array<double, 3> at{NAN, NAN, NAN};
   int pending = 3;
   for (int k = 1; k < samples && pending > 0; ++k) {
-    for (size_t i = 0; i < kFractions.size(); ++i) {
-      const double target = low + kFractions[i] * (high - low);
+    for (size_t i = 0; i < targets.size(); ++i) {
+      const double target = targets[i];
       if (std::isnan(at[i]) && level[k] >= target && level[k - 1] < target) {
         at[i] = -steps.half_m +
                 ((k - 1) + (target - level[k - 1]) / (level[k] - level[k - 1])) * step_m;
@@ -305,12 +306,14 @@ bool profile(const ImageView& frame, const MarkerFrame& marker, double e_m, doub
   // levels (docs/decisions.md "Edges in linear light").
   const double edge_low = 0.5 * (edge[0] + edge[1]);
   const double edge_high = 0.5 * (edge[samples - 1] + edge[samples - 2]);
-  double shortfall_m = 0.0;
-  for (int k = 0; k < samples; ++k) {
-    const double rise = std::clamp((edge[k] - edge_low) / (edge_high - edge_low), 0.0, 1.0);
-    shortfall_m += (k == 0 || k == samples - 1 ? 0.5 : 1.0) * (1.0 - rise) * step_m;
-  }
-  out->at_edge = -steps.half_m + shortfall_m;
+  const double per_rise = 1.0 / (edge_high - edge_low);
+  double shortfall = 0.0;  // in steps
+  for (int k = 0; k < samples; ++k)
+    shortfall += 1.0 - std::clamp((edge[k] - edge_low) * per_rise, 0.0, 1.0);
+  // The trapezoid's end samples count half.
+  shortfall -= 0.5 * (2.0 - std::clamp((edge[0] - edge_low) * per_rise, 0.0, 1.0) -
+                      std::clamp((edge[samples - 1] - edge_low) * per_rise, 0.0, 1.0));
+  out->at_edge = -steps.half_m + shortfall * step_m;
   return true;
 }
 
