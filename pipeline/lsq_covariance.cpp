@@ -21,13 +21,17 @@ constexpr int kN = kLsqParams;
 // them out would measure only the markers that happen to agree): the shift and turn each marker's
 // residuals ask for, pooled over the 2K - 3 (shift) and K - 1 (turn) degrees of freedom the pose
 // leaves them (K >= 2 markers).
-LsqNormal LsqCovariance::placement_information(const ViewGeometry& view,
-                                               const PositioningParams& params,
-                                               std::span<const LsqPoint> points,
-                                               std::span<const MarkerFix> fixes,
-                                               std::span<const bool> consistent,
-                                               std::span<const bool> use, const LsqState& st) {
+LsqNormal LsqCovariance::placement_information(
+    const ViewGeometry& view, const PositioningParams& params, std::span<const LsqPoint> points,
+    std::span<const MarkerFix> fixes, std::span<const bool> consistent, std::span<const bool> use,
+    const LsqState& st, const LsqModel& model) {
   const double k = params.lsq_huber_px;
+  // Only the free unknowns' rows: the covariance reads M through
+  // (J^T W J)^-1, whose other rows are zero.
+  int free[kN];
+  int free_n = 0;
+  for (int c = 0; c < kN; ++c)
+    if (model.active[c]) free[free_n++] = c;
   const PointCamera centre = centre_camera(st);
   const int n_fix = static_cast<int>(fixes.size());
   for (int f = 0; f < n_fix; ++f) marker_terms_[f] = MarkerTerm{};
@@ -41,7 +45,7 @@ LsqNormal LsqCovariance::placement_information(const ViewGeometry& view,
     // evidence of how far off their places the markers are.
     const double w = !use[pt.fix] ? 0.0 : r <= k ? 1.0 : k / r;
     double jx[kN], jy[kN];
-    point_jacobian(view, pt, cam, jx, jy);
+    point_jacobian(view, pt, cam, jx, jy, model.tilt_free());
     // A marker shift moves its points as a camera shift the other way; its
     // rotation moves a point at (dx, dy) from the centre by (−dy, dx)·dθ.
     const MarkerFix& fix = fixes[pt.fix];
@@ -49,8 +53,10 @@ LsqNormal LsqCovariance::placement_information(const ViewGeometry& view,
     const double mx[3] = {-jx[kLsqTx], -jx[kLsqTy], jx[kLsqTx] * oy - jx[kLsqTy] * ox};
     const double my[3] = {-jy[kLsqTx], -jy[kLsqTy], jy[kLsqTx] * oy - jy[kLsqTy] * ox};
     MarkerTerm& term = marker_terms_[pt.fix];
-    for (int r1 = 0; r1 < kN; ++r1)
+    for (int i = 0; i < free_n; ++i) {
+      const int r1 = free[i];
       for (int c = 0; c < 3; ++c) term.b[r1 * 3 + c] += w * (jx[r1] * mx[c] + jy[r1] * my[c]);
+    }
     for (int r1 = 0; r1 < 3; ++r1) {
       term.jtr[r1] += mx[r1] * rx + my[r1] * ry;
       for (int c = 0; c < 3; ++c) term.jtj[r1 * 3 + c] += mx[r1] * mx[c] + my[r1] * my[c];
@@ -65,14 +71,8 @@ LsqNormal LsqCovariance::placement_information(const ViewGeometry& view,
   for (int f = 0; f < n_fix; ++f) {
     const MarkerTerm& term = marker_terms_[f];
     if (term.points == 0) continue;
-    LsqNormal a{};
-    LsqVector b{}, x{};
-    for (int r1 = 0; r1 < 3; ++r1) {
-      b[r1] = term.jtr[r1];
-      for (int c = 0; c < 3; ++c) a[r1 * kN + c] = term.jtj[r1 * 3 + c];
-    }
-    const std::array<bool, kN> three{true, true, true, false, false, false, false, false, false};
-    if (!solve_spd<kN>(a, three, b, &x)) continue;
+    std::array<double, 3> x{};
+    if (!solve_spd<3>(term.jtj, {true, true, true}, term.jtr, &x)) continue;
     ++markers;
     shift_m2 += x[0] * x[0] + x[1] * x[1];
     turn_rad2 += x[2] * x[2];
@@ -87,8 +87,9 @@ LsqNormal LsqCovariance::placement_information(const ViewGeometry& view,
     const double dk[3] = {pl.sigma_m * pl.sigma_m + placement_var_m2,
                           pl.sigma_m * pl.sigma_m + placement_var_m2,
                           pl.sigma_yaw_rad * pl.sigma_yaw_rad + turn_var_rad2};
-    for (int r1 = 0; r1 < kN; ++r1)
-      for (int c = 0; c < kN; ++c) {
+    for (int i = 0; i < free_n; ++i)
+      for (int j = 0; j < free_n; ++j) {
+        const int r1 = free[i], c = free[j];
         double sum = 0.0;
         for (int q = 0; q < 3; ++q) sum += term.b[r1 * 3 + q] * dk[q] * term.b[c * 3 + q];
         m[r1 * kN + c] += sum;
@@ -110,7 +111,7 @@ bool LsqCovariance::robot_covariance(const ViewGeometry& view, const Positioning
                                      const LsqState& st, const LsqNormal& a, double wr2, int n,
                                      const Pose2D& robot, std::array<double, 9>* out) {
   const LsqNormal placement =
-      placement_information(view, params, points, fixes, consistent, use, st);
+      placement_information(view, params, points, fixes, consistent, use, st, model);
   const double dof = std::max(1, n - model.free_count());
   const double sigma2 = wr2 / dof;
   // g = the first three columns of (J^T W J)^-1.

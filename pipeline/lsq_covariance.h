@@ -31,7 +31,7 @@ class LsqCovariance {
                                   std::span<const LsqPoint> points,
                                   std::span<const MarkerFix> fixes,
                                   std::span<const bool> consistent, std::span<const bool> use,
-                                  const LsqState& st);
+                                  const LsqState& st, const LsqModel& model);
 
   // Per marker: B_k (kLsqParams x 3, row-major), and J_m^T J_m, J_m^T r of
   // its own placement parameters (centre x, y, rotation).
