@@ -22,37 +22,40 @@ inline Mat3 exp_so3(const Vec3& w) {
 // Cholesky solve of the active block of a symmetric positive definite N×N
 // system; inactive unknowns get 0. False when the block is not SPD.
 template <int N>
-bool solve_spd(std::array<double, N * N> a, const std::array<bool, N>& active,
-               std::array<double, N> b, std::array<double, N>* x) {
-  for (int i = 0; i < N; ++i) {
-    if (active[i]) continue;
-    for (int j = 0; j < N; ++j) a[i * N + j] = a[j * N + i] = 0.0;
-    a[i * N + i] = 1.0;
-    b[i] = 0.0;
-  }
-  for (int j = 0; j < N; ++j) {
-    double d = a[j * N + j];
-    for (int k = 0; k < j; ++k) d -= a[j * N + k] * a[j * N + k];
+bool solve_spd(const std::array<double, N * N>& a, const std::array<bool, N>& active,
+               const std::array<double, N>& b, std::array<double, N>* x) {
+  // Factored on the active block alone: the fits free 4-7 of their 10
+  // unknowns, and an inactive one's zeroed row would only subtract zeros.
+  std::array<int, N> idx{};
+  int m = 0;
+  for (int i = 0; i < N; ++i)
+    if (active[i]) idx[m++] = i;
+  std::array<double, N * N> l{};
+  std::array<double, N> y{};
+  for (int j = 0; j < m; ++j) {
+    double d = a[idx[j] * N + idx[j]];
+    for (int k = 0; k < j; ++k) d -= l[j * N + k] * l[j * N + k];
     if (!(d > 0.0)) return false;
     d = std::sqrt(d);
-    a[j * N + j] = d;
-    for (int i = j + 1; i < N; ++i) {
-      double s = a[i * N + j];
-      for (int k = 0; k < j; ++k) s -= a[i * N + k] * a[j * N + k];
-      a[i * N + j] = s / d;
+    l[j * N + j] = d;
+    for (int i = j + 1; i < m; ++i) {
+      double s = a[idx[i] * N + idx[j]];
+      for (int k = 0; k < j; ++k) s -= l[i * N + k] * l[j * N + k];
+      l[i * N + j] = s / d;
     }
   }
-  for (int i = 0; i < N; ++i) {
-    double s = b[i];
-    for (int k = 0; k < i; ++k) s -= a[i * N + k] * b[k];
-    b[i] = s / a[i * N + i];
+  for (int i = 0; i < m; ++i) {
+    double s = b[idx[i]];
+    for (int k = 0; k < i; ++k) s -= l[i * N + k] * y[k];
+    y[i] = s / l[i * N + i];
   }
-  for (int i = N - 1; i >= 0; --i) {
-    double s = b[i];
-    for (int k = i + 1; k < N; ++k) s -= a[k * N + i] * b[k];
-    b[i] = s / a[i * N + i];
+  for (int i = m - 1; i >= 0; --i) {
+    double s = y[i];
+    for (int k = i + 1; k < m; ++k) s -= l[k * N + i] * y[k];
+    y[i] = s / l[i * N + i];
   }
-  *x = b;
+  x->fill(0.0);
+  for (int i = 0; i < m; ++i) (*x)[idx[i]] = y[i];
   return true;
 }
 
