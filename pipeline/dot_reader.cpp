@@ -36,6 +36,22 @@ namespace {
 // contrast. {−1, −1} outside the frame.
 using Brightness = std::array<double, 2>;
 
+// Each channel's share of luma by level, the same products 0.299 r,
+// 0.587 g, 0.114 b: three loads instead of three conversions and
+// multiplications, for every pixel of ~800 samples a tracked frame.
+const std::array<std::array<double, 256>, 3>& luma_shares() {
+  static const auto table = [] {
+    std::array<std::array<double, 256>, 3> t{};
+    for (int i = 0; i < 256; ++i) {
+      t[0][static_cast<size_t>(i)] = 0.299 * i;
+      t[1][static_cast<size_t>(i)] = 0.587 * i;
+      t[2][static_cast<size_t>(i)] = 0.114 * i;
+    }
+    return t;
+  }();
+  return table;
+}
+
 Brightness brightness_at(const ImageView& frame, double u, double v) {
   const int x0 = floor_int(u), y0 = floor_int(v);
   if (x0 < 0 || y0 < 0 || x0 + 1 >= frame.width || y0 + 1 >= frame.height) return {-1.0, -1.0};
@@ -44,10 +60,11 @@ Brightness brightness_at(const ImageView& frame, double u, double v) {
   Brightness out{0.0, 0.0};
   std::array<Rgb, 4> px;
   read_rgb_2x2(frame, x0, y0, &px);
+  const auto& share = luma_shares();
   for (int k = 0; k < 4; ++k) {
     const auto [r, g, b] = px[k];
     out[0] += w[k] * std::max({r, g, b});
-    out[1] += w[k] * (0.299 * r + 0.587 * g + 0.114 * b);
+    out[1] += w[k] * (share[0][r] + share[1][g] + share[2][b]);
   }
   return out;
 }
