@@ -95,24 +95,25 @@ void point_jacobian(const ViewGeometry& view, const LsqPoint& pt, const PointCam
   const Vec3& d = cam.d;
   const Vec3 p = mat_vec(cam.rt, d);
   const double iz = 1.0 / p[2];
-  double dp[3][kN] = {};
-  for (int row = 0; row < 3; ++row) {
-    dp[row][kLsqTx] = -cam.rt[row * 3 + 0];
-    dp[row][kLsqTy] = -cam.rt[row * 3 + 1];
-    dp[row][kLsqTz] = -cam.rt[row * 3 + 2];
+  // ∂r/∂param = −f·∂(projection)/∂param, from the column ∂p/∂param.
+  auto column = [&](int c, const Vec3& dp) {
+    jx[c] = -fx * iz * (dp[0] - p[0] * iz * dp[2]);
+    jy[c] = -fy * iz * (dp[1] - p[1] * iz * dp[2]);
+  };
+  for (int c : {kLsqTx, kLsqTy, kLsqTz}) {
+    const int axis = c == kLsqTz ? 2 : c;
+    column(c, {-cam.rt[axis], -cam.rt[3 + axis], -cam.rt[6 + axis]});
   }
   const int rot_cols[3] = {kLsqYaw, kLsqTiltX, kLsqTiltY};
-  for (int c = 0; c < (with_tilt ? 3 : 1); ++c) {
-    const Vec3& w3 = cam.axis[c];
+  for (int k = 0; k < 3; ++k) {
+    if (k > 0 && !with_tilt) {
+      jx[rot_cols[k]] = jy[rot_cols[k]] = 0.0;
+      continue;
+    }
+    const Vec3& w3 = cam.axis[k];
     const Vec3 cross{d[1] * w3[2] - d[2] * w3[1], d[2] * w3[0] - d[0] * w3[2],
                      d[0] * w3[1] - d[1] * w3[0]};  // [d]×·w = d × w
-    const Vec3 col = mat_vec(cam.rt, cross);
-    for (int row = 0; row < 3; ++row) dp[row][rot_cols[c]] = col[row];
-  }
-  for (int c = 0; c < kLsqVx; ++c) {
-    // ∂r/∂param = −f·∂(projection)/∂param
-    jx[c] = -fx * iz * (dp[0][c] - p[0] * iz * dp[2][c]);
-    jy[c] = -fy * iz * (dp[1][c] - p[1] * iz * dp[2][c]);
+    column(rot_cols[k], mat_vec(cam.rt, cross));
   }
   jx[kLsqVx] = pt.tau_s * jx[kLsqTx];
   jx[kLsqVy] = pt.tau_s * jx[kLsqTy];
@@ -169,6 +170,18 @@ double accumulate(const ViewGeometry& view, const PositioningParams& params,
     if (!with_jacobian) continue;
     double jx[kN], jy[kN];
     point_jacobian(view, pt, cam, jx, jy, model.tilt_free());
+    if (pt.is_edge()) {
+      // One residual, across the edge (ry and jy are zero): half the terms.
+      for (int i = 0; i < free_n; ++i) {
+        const int r1 = free[i];
+        (*b)[r1] -= w * (jx[r1] * rx);
+        for (int j = i; j < free_n; ++j) {
+          const int c = free[j];
+          (*a)[r1 * kN + c] += w * (jx[r1] * jx[c]);
+        }
+      }
+      continue;
+    }
     for (int i = 0; i < free_n; ++i) {
       const int r1 = free[i];
       (*b)[r1] -= w * (jx[r1] * rx + jy[r1] * ry);
