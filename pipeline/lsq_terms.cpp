@@ -10,22 +10,28 @@ namespace {
 
 constexpr int kN = kLsqParams;
 
-// Rotation by angle a about the world's vertical, applied on the left.
-Mat3 turned(const Mat3& r, double a) {
-  const double s = std::sin(a), c = std::cos(a);
+// Rotation by an angle of sine s and cosine c about the world's vertical,
+// applied on the left.
+Mat3 turned(const Mat3& r, double s, double c) {
   return mat_mul({c, -s, 0.0, s, c, 0.0, 0.0, 0.0, 1.0}, r);
 }
 
 // The camera when a point tau_s after the centre row was exposed: t + v·tau
-// and Exp(w·tau·z)·R.
+// and Exp(w·tau·z)·R, whose turn has sine sin_wt and cosine cos_wt.
+void camera_at(const LsqState& st, double tau_s, double sin_wt, double cos_wt, Vec3* t_w,
+               Mat3* r_wc) {
+  *t_w = {st.t_w[0] + st.vx * tau_s, st.t_w[1] + st.vy * tau_s, st.t_w[2]};
+  *r_wc = turned(st.r_wc, sin_wt, cos_wt);
+}
+
 void camera_at(const LsqState& st, double tau_s, Vec3* t_w, Mat3* r_wc) {
   if (tau_s == 0.0) {  // global shutter: no arithmetic, the same bits
     *t_w = st.t_w;
     *r_wc = st.r_wc;
     return;
   }
-  *t_w = {st.t_w[0] + st.vx * tau_s, st.t_w[1] + st.vy * tau_s, st.t_w[2]};
-  *r_wc = turned(st.r_wc, st.w * tau_s);
+  const double a = st.w * tau_s;
+  camera_at(st, tau_s, std::sin(a), std::cos(a), t_w, r_wc);
 }
 
 // An edge point keeps only its residual's component across the edge, less
@@ -58,13 +64,14 @@ PointCamera point_camera(const LsqState& st, const LsqPoint& pt, const PointCame
   PointCamera cam = centre;
   Vec3 t_w = st.t_w;
   if (pt.tau_s != 0.0) {
+    // One sine and cosine for the camera's turn and its axes'.
+    const double a = st.w * pt.tau_s, sa = std::sin(a), ca = std::cos(a);
     Mat3 r_wc;
-    camera_at(st, pt.tau_s, &t_w, &r_wc);
+    camera_at(st, pt.tau_s, sa, ca, &t_w, &r_wc);
     cam.rt = mat_transpose(r_wc);
     if (with_axes) {
       // The turn about the vertical turns the level axes with it; the yaw
       // axis stays vertical.
-      const double a = st.w * pt.tau_s, sa = std::sin(a), ca = std::cos(a);
       for (int k = 1; k < 3; ++k) {
         const Vec3 l = centre.axis[k];
         cam.axis[k] = {ca * l[0] - sa * l[1], sa * l[0] + ca * l[1], l[2]};
