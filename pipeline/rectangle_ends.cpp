@@ -251,7 +251,7 @@ bool read_linear_profile(const ImageView& frame, const MarkerFrame& marker, doub
 // it leaves the frame or the contrast is too low.
 bool profile(const ImageView& frame, const MarkerFrame& marker, double e_m, double n_m, double de,
              double dn, const ProfileSteps& steps, EdgeLevels levels, EdgeChannel channel,
-             Crossings* out) {
+             bool with_spread, Crossings* out) {
   const int samples = steps.samples;
   const double step_m = steps.step_m;
   // Levels (contrast, blur) and what the edge is measured in (the darkest
@@ -270,11 +270,12 @@ bool profile(const ImageView& frame, const MarkerFrame& marker, double e_m, doub
   const double high = 0.5 * (level[samples - 1] + level[samples - 2]);
   if (high - low < kMinContrast) return false;
   // The first upward crossing of each of 25, 50 and 75 % of the rise, in
-  // one pass.
+  // one pass; of 50 % alone without the spread (a long side's: only the
+  // ends' spread is the marker's blur).
   const std::array<double, 3> targets{low + 0.25 * (high - low), low + 0.5 * (high - low),
                                       low + 0.75 * (high - low)};
-  std::array<double, 3> at{NAN, NAN, NAN};
-  int pending = 3;
+  std::array<double, 3> at{with_spread ? NAN : 0.0, NAN, with_spread ? NAN : 0.0};
+  int pending = with_spread ? 3 : 1;
   for (int k = 1; k < samples && pending > 0; ++k) {
     for (size_t i = 0; i < targets.size(); ++i) {
       const double target = targets[i];
@@ -285,8 +286,10 @@ bool profile(const ImageView& frame, const MarkerFrame& marker, double e_m, doub
       }
     }
   }
-  out->at25 = at[0];
-  out->at75 = at[2];
+  if (with_spread) {
+    out->at25 = at[0];
+    out->at75 = at[2];
+  }
   // The edge: where a sharp step with the profile's area would be (the
   // rise's shortfall summed from the inner end), so every sample counts
   // rather than the two around the half-way level: on tilted independent
@@ -320,7 +323,7 @@ bool profile(const ImageView& frame, const MarkerFrame& marker, double e_m, doub
 
 // The edge point of the edge through (e_m, n_m) with outward direction
 // (de, dn), from parallel profiles at `fractions` of `offset_m` along it;
-// *spread_m: their mean 25–75 % distance (NaN: not measured).
+// *spread_m, unless null: their mean 25–75 % distance (NaN: not measured).
 template <size_t N>
 EdgeCrossing cross_edge(const ImageView& frame, const MarkerFrame& marker, double e_m, double n_m,
                         double de, double dn, double offset_m,
@@ -336,7 +339,8 @@ EdgeCrossing cross_edge(const ImageView& frame, const MarkerFrame& marker, doubl
     const double along_m = fraction * offset_m;
     const double pe = e_m - along_m * dn, pn = n_m + along_m * de;
     Crossings c;
-    if (!profile(frame, marker, pe, pn, de, dn, steps, levels, channel, &c)) continue;
+    if (!profile(frame, marker, pe, pn, de, dn, steps, levels, channel, spread_m != nullptr, &c))
+      continue;
     if (!std::isnan(c.at25) && !std::isnan(c.at75)) {
       spread_sum_m += c.at75 - c.at25;
       ++spreads;
@@ -350,7 +354,7 @@ EdgeCrossing cross_edge(const ImageView& frame, const MarkerFrame& marker, doubl
     v_sum += v;
     ++found;
   }
-  *spread_m = spreads > 0 ? spread_sum_m / spreads : NAN;
+  if (spread_m != nullptr) *spread_m = spreads > 0 ? spread_sum_m / spreads : NAN;
   // An edge crossed by fewer than all profiles is partly hidden, dirty or
   // out of the frame: its mean would lean towards the part that was seen.
   if (found < static_cast<int>(N)) return out;
@@ -377,7 +381,7 @@ EdgeCrossing measure_edge(const ImageView& frame, const MarkerFrame& marker, dou
                       fitted_steps(fitted_samples), levels, channel, spread_m);
   const ProfileSteps steps = axis_steps(marker, de, dn);
   if (steps.samples == 0) {
-    *spread_m = NAN;
+    if (spread_m != nullptr) *spread_m = NAN;
     return {};
   }
   return cross_edge(frame, marker, e_m, n_m, de, dn, offset_m, kFourProfiles, steps, levels,
@@ -414,9 +418,8 @@ RectangleEdges measure_edges(const ImageView& frame, const MarkerFrame& marker, 
   const double de = red ? 1.0 : -1.0;
   for (int k = 0; k + 1 < layout.bits && out.side_count < kMaxSideCrossings; ++k) {
     const double n_m = 0.5 * (layout.slot_n_m(k) + layout.slot_n_m(k + 1));
-    double spread_m = NAN;
     const EdgeCrossing c = measure_edge(frame, marker, de * layout.rect_width_m, n_m, de, 0.0,
-                                        kSideProfileOffset_m, samples, levels, channel, &spread_m);
+                                        kSideProfileOffset_m, samples, levels, channel, nullptr);
     if (c.found) out.side[static_cast<size_t>(out.side_count++)] = c;
   }
   return out;
