@@ -116,7 +116,7 @@ constexpr double kReferenceSpreadN = 0.1;
 
 MarkerRegion::MarkerRegion(const MarkerFrame& marker, double e0_m, double e1_m, double n0_m,
                            double n1_m, int width, int height)
-    : marker_(marker), width_(width) {
+    : centre_u_px_(marker.centre_u_px), centre_v_px_(marker.centre_v_px), width_(width) {
   const double det = marker.east_u * marker.north_v - marker.east_v * marker.north_u;
   const double px_per_m = std::hypot(marker.north_u, marker.north_v);
   if (!(std::abs(det) > 0.0) || !(px_per_m > 0.0) || !(e0_m <= e1_m) || !(n0_m <= n1_m)) return;
@@ -132,9 +132,7 @@ MarkerRegion::MarkerRegion(const MarkerFrame& marker, double e0_m, double e1_m, 
   // (hi_m − m_per_dv·dv)/m_per_du, in the order of m_per_du's sign.
   auto bound = [](double m_per_dv, double m_per_du, double lo_m, double hi_m) {
     Bound b;
-    b.per_row_m = m_per_dv, b.lo_m = lo_m, b.hi_m = hi_m;
-    b.along_row = m_per_du != 0.0;
-    if (!b.along_row) return b;
+    if (m_per_du == 0.0) return b;
     const double px_per_m = 1.0 / m_per_du;
     b.lo_px = (m_per_du > 0.0 ? lo_m : hi_m) * px_per_m;
     b.hi_px = (m_per_du > 0.0 ? hi_m : lo_m) * px_per_m;
@@ -155,27 +153,6 @@ MarkerRegion::MarkerRegion(const MarkerFrame& marker, double e0_m, double e1_m, 
   if (!std::isfinite(v_min) || !std::isfinite(v_max)) return;
   first_row_ = static_cast<int>(std::max(0.0, std::floor(v_min)));
   last_row_ = static_cast<int>(std::min(height - 1.0, std::ceil(v_max)));
-}
-
-PixelSpan MarkerRegion::row(int y) const {
-  // Along row y, e and n are affine in u: each bounds u to an interval.
-  const double dv = y - marker_.centre_v_px;
-  double du_lo = -INFINITY, du_hi = INFINITY;
-  for (const Bound& b : bounds_) {
-    if (!b.along_row) {
-      const double at_m = dv * b.per_row_m;
-      if (at_m < b.lo_m || at_m > b.hi_m) return {};
-      continue;
-    }
-    du_lo = std::max(du_lo, b.lo_px + dv * b.slope);
-    du_hi = std::min(du_hi, b.hi_px + dv * b.slope);
-  }
-  PixelSpan out;
-  if (!(du_lo <= du_hi)) return out;
-  // Clamped first: a span beyond the frame comes out empty (x0 > x1).
-  out.x0 = floor_int(std::clamp(marker_.centre_u_px + du_lo, 0.0, static_cast<double>(width_)));
-  out.x1 = ceil_int(std::clamp(marker_.centre_u_px + du_hi, -1.0, width_ - 1.0));
-  return out;
 }
 
 void ask_marker_region(const ImageView& frame, const MarkerFrame& marker, double e0_m, double e1_m,

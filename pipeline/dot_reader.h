@@ -2,10 +2,13 @@
 // Stage 4: the marker's frame in the image (Heading) and its code (Read_Dots).
 // The red→green vector is West; North follows from it; the dots are read
 // slot by slot, most significant bit northernmost (SPEC §2).
+#include <algorithm>
 #include <array>
+#include <cmath>
 
 #include "core/ceiling_layout.h"
 #include "core/image.h"
+#include "core/int_rounding.h"
 #include "pipeline/detector_params.h"
 #include "pipeline/rectangle_fit.h"
 
@@ -41,20 +44,31 @@ class MarkerRegion {
                int width, int height);
   int first_row() const { return first_row_; }
   int last_row() const { return last_row_; }
-  PixelSpan row(int y) const;
+  // Inline: a tracked 1280x960 frame asks for ~3000 rows.
+  PixelSpan row(int y) const {
+    const double dv = y - centre_v_px_;
+    const Bound& a = bounds_[0];
+    const Bound& b = bounds_[1];
+    const double du_lo = std::max(a.lo_px + dv * a.slope, b.lo_px + dv * b.slope);
+    const double du_hi = std::min(a.hi_px + dv * a.slope, b.hi_px + dv * b.slope);
+    PixelSpan out;
+    if (!(du_lo <= du_hi)) return out;
+    // Clamped first: a span beyond the frame comes out empty (x0 > x1).
+    out.x0 = floor_int(std::clamp(centre_u_px_ + du_lo, 0.0, static_cast<double>(width_)));
+    out.x1 = ceil_int(std::clamp(centre_u_px_ + du_hi, -1.0, width_ - 1.0));
+    return out;
+  }
 
  private:
   // One of the rectangle's two coordinates (e, n) within its limits, on
-  // the row dv below the centre: where it changes along the row, the
-  // columns du (from the centre's) lo_px + dv·slope ≤ du ≤ hi_px +
-  // dv·slope; where it does not (along_row false), every column or none,
-  // as dv·per_row_m lies within [lo_m, hi_m] or not.
+  // the row dv below the centre: the columns du (from the centre's)
+  // lo_px + dv·slope ≤ du ≤ hi_px + dv·slope. A coordinate that does not
+  // change along rows bounds the rows alone, as the corners' rows already
+  // do: every column (±infinity).
   struct Bound {
-    bool along_row = true;
-    double lo_px = 0.0, hi_px = 0.0, slope = 0.0;
-    double per_row_m = 0.0, lo_m = 0.0, hi_m = 0.0;
+    double lo_px = -INFINITY, hi_px = INFINITY, slope = 0.0;
   };
-  MarkerFrame marker_;
+  double centre_u_px_ = 0.0, centre_v_px_ = 0.0;
   std::array<Bound, 2> bounds_{};
   int width_ = 0;
   int first_row_ = 0, last_row_ = -1;
