@@ -28,10 +28,8 @@ LsqNormal LsqCovariance::placement_information(
   const double k = params.lsq_huber_px;
   // Only the free unknowns' rows: the covariance reads M through
   // (J^T W J)^-1, whose other rows are zero.
-  int free[kN];
-  int free_n = 0;
-  for (int c = 0; c < kN; ++c)
-    if (model.active[c]) free[free_n++] = c;
+  std::array<int, kN> free{};
+  const int free_n = model.free_unknowns(&free);
   const PointCamera centre = centre_camera(st);
   const int n_fix = static_cast<int>(fixes.size());
   for (int f = 0; f < n_fix; ++f) marker_terms_[f] = MarkerTerm{};

@@ -44,6 +44,13 @@ void across_edge(const LsqPoint& pt, double offset_px, double weight, double* x,
 
 }  // namespace
 
+int LsqModel::free_unknowns(std::array<int, kLsqParams>* out) const {
+  int n = 0;
+  for (int c = 0; c < kLsqParams; ++c)
+    if (active[c]) (*out)[static_cast<size_t>(n++)] = c;
+  return n;
+}
+
 int LsqModel::free_count() const {
   int n = 0;
   for (bool a : active) n += a ? 1 : 0;
@@ -154,10 +161,8 @@ double accumulate(const ViewGeometry& view, const PositioningParams& params,
   const PointCamera centre = centre_camera(st);
   // Only the free unknowns' rows and columns: a fit frees 4-6 of the 10, and
   // the update is most of a point's cost.
-  int free[kN];
-  int free_n = 0;
-  for (int c = 0; c < kN; ++c)
-    if (model.active[c]) free[free_n++] = c;
+  std::array<int, kN> free{};
+  const int free_n = model.free_unknowns(&free);
   if (with_jacobian) {
     a->fill(0.0);
     b->fill(0.0);

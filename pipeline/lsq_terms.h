@@ -72,6 +72,8 @@ struct LsqModel {
   bool tilt_free() const { return active[kLsqTiltX]; }
   bool motion_free() const { return active[kLsqVx]; }
   int free_count() const;
+  // The free unknowns' indices, ascending, in out[0 .. return value).
+  int free_unknowns(std::array<int, kLsqParams>* out) const;
 };
 
 // What a point's residual and Jacobian need of its camera: Rᵀ, the
