@@ -91,14 +91,15 @@ FullSweepReason plan_tracking(const ViewGeometry& view, const DetectorParams& pa
   const double error_m = errors.max_position_m();
   const double error_rad = errors.max_yaw_rad();
   const double half_diagonal_px = 0.5 * std::hypot(k.width, k.height);
-  // The view's motion during half the readout, pixels: translation, and
-  // the yaw's rotation at the frame's corners.
-  const double readout_px =
-      (std::hypot(s.x[3], s.x[4]) * px_per_m + std::abs(s.x[5]) * half_diagonal_px) * 0.5 *
-      std::max(0.0, k.readout_ms) * 1e-3;
-  const double margin_px =
-      params.track_margin_px +
-      params.track_margin_errors * (error_m * px_per_m + error_rad * half_diagonal_px) + readout_px;
+  // The view's speed, pixels a second: translation, and the yaw's rotation
+  // at the frame's corners; how far it moves during half the readout.
+  const double readout_s = std::max(0.0, k.readout_ms) * 1e-3;
+  const double view_px_per_s =
+      std::hypot(s.x[3], s.x[4]) * px_per_m + std::abs(s.x[5]) * half_diagonal_px;
+  const double readout_px = view_px_per_s * 0.5 * readout_s;
+  const double predictions_px =
+      params.track_margin_errors * (error_m * px_per_m + error_rad * half_diagonal_px);
+  const double margin_px = params.track_margin_px + predictions_px + readout_px;
   plan->margin_px = margin_px;
   plan->edges = params.track_edges && !positions_from_centroids(mode);
   plan->window_count = 0;
@@ -207,10 +208,16 @@ FullSweepReason plan_tracking(const ViewGeometry& view, const DetectorParams& pa
   if (plan->edges) {
     // Edge-tracked frames sweep no window, so the windows' area does not
     // matter: the profiles across each predicted edge must cross it, which
-    // they do while the prediction's likely error (the margin less its
-    // fixed part) stays within a profile's half-length. A marker found off
-    // its prediction is measured again where it is, or refused (pipeline).
-    const double error_px = margin_px - params.track_margin_px;
+    // they do while the prediction's likely error stays within a
+    // profile's half-length. A marker found off its prediction is measured
+    // again where it is, or refused (pipeline). Each marker is predicted
+    // where its own centre row is exposed, so of the readout only the
+    // motion within the marker's rows is unpredicted, not the half frame's
+    // a window allows for.
+    const double marker_half_rows_px =
+        std::hypot(layout.rect_width_m, 0.5 * layout.rect_height_m) * px_per_m;
+    const double error_px =
+        predictions_px + view_px_per_s * readout_s * marker_half_rows_px / k.height;
     return error_px <= kEdgeProfileHalf_m * px_per_m ? FullSweepReason::kNone
                                                      : FullSweepReason::kUncertain;
   }

@@ -245,6 +245,39 @@ TEST(PlanTracking, WindowsHoldEveryWholeMarkerAndGrowWithThePredictionsErrors) {
             FullSweepReason::kUncertain);
 }
 
+// Under a rolling shutter each predicted marker's frame is computed where
+// its own centre row is exposed, so an edge-tracked plan allows only for the
+// motion within a marker's rows, while windows allow for half the frame's
+// readout. A 25 ms readout turning at 3 rad/s (~15 px across half the
+// frame) stays edge-tracked; at 8 rad/s the motion within a marker alone
+// passes a profile's half-length and the frame is swept whole.
+TEST(PlanTracking, AnEdgeTrackedPlanAllowsForTheReadoutWithinAMarkerOnly) {
+  PipelineConfig config;
+  config.detector.track_edges = true;
+  config.intrinsics.readout_ms = 25.0;
+  const ViewGeometry view(config);
+  PredictionErrors errors;
+  for (int k = 0; k < 6; ++k) errors.add(0.0002, 0.0002);
+  MotionState s;
+  s.x[0] = 2.1, s.x[1] = 2.0, s.x[2] = 0.3;
+  s.x[5] = 3.0;  // rad/s
+  TrackingPlan plan;
+  EXPECT_EQ(plan_tracking(view, config.detector, config.positioning.mode, s, errors, &plan),
+            FullSweepReason::kNone);
+  EXPECT_GT(plan.predicted_count, 0);
+  // The windows' margin holds half the readout's turn at the frame's corner.
+  const double half_diagonal_px = 0.5 * std::hypot(640.0, 480.0);
+  EXPECT_GE(plan.margin_px, config.detector.track_margin_px + 3.0 * half_diagonal_px * 0.0125);
+  s.x[5] = 8.0;
+  EXPECT_EQ(plan_tracking(view, config.detector, config.positioning.mode, s, errors, &plan),
+            FullSweepReason::kUncertain);
+  // A global shutter has no readout to allow for at any turn rate.
+  config.intrinsics.readout_ms = 0.0;
+  const ViewGeometry global(config);
+  EXPECT_EQ(plan_tracking(global, config.detector, config.positioning.mode, s, errors, &plan),
+            FullSweepReason::kNone);
+}
+
 // An edge-tracked frame of the independent renderer at `pose`, and the plan
 // an exact, confident prediction of it makes.
 struct EdgeTrackedScene {
