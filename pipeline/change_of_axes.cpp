@@ -8,7 +8,7 @@ namespace {
 
 // Level-normalized image of a marker point, as the camera of the centre row
 // would have seen it: the point was imaged tau after the centre row, when the
-// camera stood v·tau further and was turned ω·tau more. `cam_yaw_rad` (of
+// camera stood its arc's tau further and was turned ω·tau more. `cam_yaw_rad` (of
 // any of the frame's rows: an error of a degree in it moves a millimetre's
 // correction by a few micrometres) turns the camera's axes into the world's.
 void centre_row_normalized(const ViewGeometry& view, const CameraMotion& motion, double cam_yaw_rad,
@@ -21,8 +21,10 @@ void centre_row_normalized(const ViewGeometry& view, const CameraMotion& motion,
   // row's camera.
   double dx = 0.0, dy = 0.0;
   view.ceiling_offset(cam_yaw_rad, *x_n, *y_n, &dx, &dy);
-  dx += motion.vx_mps * tau_s;
-  dy += motion.vy_mps * tau_s;
+  double arc_x_m = 0.0, arc_y_m = 0.0;
+  arc_displacement(motion.vx_mps, motion.vy_mps, motion.yaw_rate_radps, tau_s, &arc_x_m, &arc_y_m);
+  dx += arc_x_m;
+  dy += arc_y_m;
   const double yaw0 = cam_yaw_rad - motion.yaw_rate_radps * tau_s;
   world_to_level(std::cos(yaw0), std::sin(yaw0), dx / depth_m, dy / depth_m, x_n, y_n);
 }

@@ -16,11 +16,13 @@ Mat3 turned(const Mat3& r, double s, double c) {
   return mat_mul({c, -s, 0.0, s, c, 0.0, 0.0, 0.0, 1.0}, r);
 }
 
-// The camera when a point tau_s after the centre row was exposed: t + v·tau
-// and Exp(w·tau·z)·R, whose turn has sine sin_wt and cosine cos_wt.
+// The camera when a point tau_s after the centre row was exposed: t moved
+// along its arc (v, w) and Exp(w·tau·z)·R, whose turn has sine sin_wt and cosine cos_wt.
 void camera_at(const LsqState& st, double tau_s, double sin_wt, double cos_wt, Vec3* t_w,
                Mat3* r_wc) {
-  *t_w = {st.t_w[0] + st.vx * tau_s, st.t_w[1] + st.vy * tau_s, st.t_w[2]};
+  double dx_m = 0.0, dy_m = 0.0;
+  arc_displacement(st.vx, st.vy, st.w, tau_s, &dx_m, &dy_m);
+  *t_w = {st.t_w[0] + dx_m, st.t_w[1] + dy_m, st.t_w[2]};
   *r_wc = turned(st.r_wc, sin_wt, cos_wt);
 }
 
@@ -63,7 +65,10 @@ PointCamera centre_camera(const LsqState& st) {
           mat_transpose(st.r_wc),
           {{{0.0, 0.0, 1.0}, {lev[0], lev[3], lev[6]}, {lev[1], lev[4], lev[7]}}},
           st.edge_offset_px,
-          st.edge_weight};
+          st.edge_weight,
+          st.vx,
+          st.vy,
+          st.w};
 }
 
 PointCamera point_camera(const LsqState& st, const LsqPoint& pt, const PointCamera& centre,
@@ -101,8 +106,10 @@ bool point_residual(const ViewGeometry& view, const LsqPoint& pt, const PointCam
 
 // For a ceiling point P, d = P − t and p = Rᵀd: ∂p/∂t = −Rᵀ, ∂p/∂ω = Rᵀ[d]×,
 // and x = X/Z, y = Y/Z give ∂x/∂p = (1/Z, 0, −X/Z²), ∂y/∂p = (0, 1/Z, −Y/Z²).
-// A point exposed tau after the centre row has its camera at t + v·tau and
-// Exp(w·tau·z)·R, so v and w move it as t and the yaw do, tau times as much.
+// A point exposed tau after the centre row has its camera at
+// t + v·tau + w·tau²/2·(−vy, vx) (arc_displacement) and Exp(w·tau·z)·R, so
+// v and w move it as t and the yaw do, tau times as much, and each also
+// turns the other's share of the arc.
 void point_jacobian(const ViewGeometry& view, const LsqPoint& pt, const PointCamera& cam,
                     double* jx, double* jy, bool with_tilt) {
   const double fx = view.intrinsics().fx, fy = view.intrinsics().fy;
@@ -129,12 +136,12 @@ void point_jacobian(const ViewGeometry& view, const LsqPoint& pt, const PointCam
                      d[0] * w3[1] - d[1] * w3[0]};  // [d]×·w = d × w
     column(rot_cols[k], mat_vec(cam.rt, cross));
   }
-  jx[kLsqVx] = pt.tau_s * jx[kLsqTx];
-  jx[kLsqVy] = pt.tau_s * jx[kLsqTy];
-  jx[kLsqYawRate] = pt.tau_s * jx[kLsqYaw];
-  jy[kLsqVx] = pt.tau_s * jy[kLsqTx];
-  jy[kLsqVy] = pt.tau_s * jy[kLsqTy];
-  jy[kLsqYawRate] = pt.tau_s * jy[kLsqYaw];
+  const double t = pt.tau_s, half_t2 = 0.5 * t * t, turn = cam.w_radps * half_t2;
+  for (double* j : {jx, jy}) {
+    j[kLsqVx] = t * j[kLsqTx] + turn * j[kLsqTy];
+    j[kLsqVy] = t * j[kLsqTy] - turn * j[kLsqTx];
+    j[kLsqYawRate] = t * j[kLsqYaw] + half_t2 * (cam.vx_mps * j[kLsqTy] - cam.vy_mps * j[kLsqTx]);
+  }
   jx[kLsqEdgeOffset] = jy[kLsqEdgeOffset] = 0.0;
   if (!pt.is_edge()) return;
   for (int c = 0; c < kN; ++c) across_edge(pt, 0.0, cam.edge_weight, &jx[c], &jy[c]);

@@ -84,6 +84,7 @@ struct PointCamera {
   std::array<Vec3, 3> axis;
   double edge_offset_px = 0.0;
   double edge_weight = 1.0;
+  double vx_mps = 0.0, vy_mps = 0.0, w_radps = 0.0;  // the motion, for the arc's Jacobian
 };
 
 // The camera at the centre row: Rᵀ and the world directions of the yaw and

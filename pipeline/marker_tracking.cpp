@@ -4,6 +4,7 @@
 #include <cmath>
 
 #include "core/camera_model.h"
+#include "pipeline/camera_motion.h"
 #include "pipeline/rectangle_ends.h"
 
 namespace ceilpose {
@@ -47,11 +48,13 @@ namespace {
 
 // The affine view of marker `p`'s frame (pixels per metre East and North at
 // its centre, over 1 cm) seen from the robot's pose `s` advanced by tau_s
-// of its motion; false when a point does not project.
+// along its arc; false when a point does not project.
 bool marker_frame_at(const ViewGeometry& view, const MarkerPlacement& p, const MotionState& s,
                      double tau_s, MarkerFrame* out) {
   constexpr double kStep_m = 0.01;
-  const Pose2D robot{s.x[0] + s.x[3] * tau_s, s.x[1] + s.x[4] * tau_s, s.x[2] + s.x[5] * tau_s};
+  double arc_x_m = 0.0, arc_y_m = 0.0;
+  arc_displacement(s.x[3], s.x[4], s.x[5], tau_s, &arc_x_m, &arc_y_m);
+  const Pose2D robot{s.x[0] + arc_x_m, s.x[1] + arc_y_m, s.x[2] + s.x[5] * tau_s};
   const CameraPose camera = camera_pose_from_robot(robot, view.mount());
   const double points_m[3][2] = {{0.0, 0.0}, {kStep_m, 0.0}, {0.0, kStep_m}};
   double u[3], v[3];
@@ -214,8 +217,7 @@ FullSweepReason plan_tracking(const ViewGeometry& view, const DetectorParams& pa
     // where its own centre row is exposed, so of the readout only the
     // motion within the marker's rows is unpredicted, not the half frame's
     // a window allows for.
-    const double marker_half_rows_px =
-        std::hypot(layout.rect_width_m, 0.5 * layout.rect_height_m) * px_per_m;
+    const double marker_half_rows_px = marker_radius_m * px_per_m;
     const double error_px =
         predictions_px + view_px_per_s * readout_s * marker_half_rows_px / k.height;
     return error_px <= kEdgeProfileHalf_m * px_per_m ? FullSweepReason::kNone

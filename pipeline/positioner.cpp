@@ -4,6 +4,7 @@
 #include <cmath>
 
 #include "pipeline/barycentric.h"
+#include "pipeline/camera_motion.h"
 #include "pipeline/grid_consistency.h"
 
 namespace ceilpose {
@@ -243,9 +244,10 @@ void Positioner::time_the_pose(std::span<const MarkerObservation> markers, int f
   double ox_m = 0.0, oy_m = 0.0;
   mount_offset_world(m, yaw, &ox_m, &oy_m);
   const double cam_x_m = est->pose.x_m + ox_m, cam_y_m = est->pose.y_m + oy_m;
-  est->pose =
-      view_.robot_from_camera(cam_x_m + motion.vx_mps * tau_s, cam_y_m + motion.vy_mps * tau_s,
-                              yaw + m.yaw_rad + motion.yaw_rate_radps * tau_s);
+  double arc_x_m = 0.0, arc_y_m = 0.0;
+  arc_displacement(motion.vx_mps, motion.vy_mps, motion.yaw_rate_radps, tau_s, &arc_x_m, &arc_y_m);
+  est->pose = view_.robot_from_camera(cam_x_m + arc_x_m, cam_y_m + arc_y_m,
+                                      yaw + m.yaw_rad + motion.yaw_rate_radps * tau_s);
 }
 
 }  // namespace ceilpose

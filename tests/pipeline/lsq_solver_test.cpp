@@ -247,5 +247,35 @@ TEST(LeastSquares, EstimatesLensHeightWhenAsked) {
   EXPECT_LT(position_error_m(est, robot), 1e-4);
 }
 
+// A robot turning on an arc, seen through a 33 ms rolling shutter: its
+// velocity turns with it during the readout, 4.5 m/s² at 1.5 m/s and
+// 3 rad/s. A velocity held constant in the world left that out, 0.6 mm over
+// half the readout, and the fit took it for a tilt of the camera (an unseen
+// rolling-shutter drive's frame was 1.5 mm off; docs/decisions.md).
+TEST(LeastSquares, ARollingShutterOnAnArcIsModelled) {
+  PipelineConfig config;
+  config.intrinsics.readout_ms = 33.0;
+  testing::SyntheticView view;
+  view.intrinsics = config.intrinsics;
+  view.forward_mps = 1.5;
+  view.noise_px = 0.05;
+  for (double yaw_rate_radps : {3.0, -3.0}) {
+    view.yaw_rate_radps = yaw_rate_radps;
+    for (const Pose2D robot : {Pose2D{2.2, 1.9, 2.8}, Pose2D{1.7, 2.4, -0.9}}) {
+      Positioner positioner(config);
+      const PoseEstimate est =
+          positioner.solve(testing::observe(view, robot), PositioningMode::kLeastSquares);
+      ASSERT_TRUE(est.valid);
+      const LsqResult& lsq = positioner.last_lsq();
+      ASSERT_TRUE(lsq.motion_estimated);
+      EXPECT_FALSE(lsq.tilt_estimated) << yaw_rate_radps;
+      EXPECT_LT(position_error_m(est, robot), 2.5e-5) << yaw_rate_radps;
+      EXPECT_NEAR(lsq.yaw_rate_radps, yaw_rate_radps, 0.05);
+      EXPECT_NEAR(lsq.cam_vx_mps, 1.5 * std::cos(robot.yaw_rad), 0.02);
+      EXPECT_NEAR(lsq.cam_vy_mps, 1.5 * std::sin(robot.yaw_rad), 0.02);
+    }
+  }
+}
+
 }  // namespace
 }  // namespace ceilpose

@@ -5,9 +5,21 @@
 
 namespace ceilpose::testing {
 
+Pose2D pose_after(const SyntheticView& view, const Pose2D& robot, double tau_s) {
+  const double w = view.yaw_rate_radps, turn = w * tau_s;
+  // ∫ R(yaw + w·t)·v dt over [0, tau]: the body-frame step, then to the world.
+  const double along = std::abs(turn) < 1e-12 ? tau_s : std::sin(turn) / w;
+  const double across = std::abs(turn) < 1e-12 ? 0.0 : (1.0 - std::cos(turn)) / w;
+  const double f = view.forward_mps * along - view.left_mps * across;
+  const double l = view.left_mps * along + view.forward_mps * across;
+  const double c = std::cos(robot.yaw_rad), s = std::sin(robot.yaw_rad);
+  return {robot.x_m + c * f - s * l, robot.y_m + s * f + c * l, robot.yaw_rad + turn};
+}
+
 std::vector<MarkerObservation> observe(const SyntheticView& view, const Pose2D& robot) {
   const CeilingLayout& l = view.layout;
   const CameraPose pose = camera_pose_from_robot(robot, view.mount);
+  const bool rolling = view.intrinsics.readout_ms > 0.0;
   std::mt19937_64 rng(view.seed);
   std::normal_distribution<double> noise(0.0, 1.0);
   std::vector<MarkerObservation> out;
@@ -16,7 +28,18 @@ std::vector<MarkerObservation> observe(const SyntheticView& view, const Pose2D& 
     for (int j = 0; j < l.codes(); ++j) {
       const Vec3 c = l.marker_centre_w(i, j);
       auto project = [&](double e, double n, double* u, double* v) {
-        return project_world_point(view.intrinsics, pose, {c[0] + e, c[1] + n, c[2]}, u, v);
+        const Vec3 p{c[0] + e, c[1] + n, c[2]};
+        if (!project_world_point(view.intrinsics, pose, p, u, v)) return false;
+        // The row and the pose it was exposed at agree after a few rounds
+        // (each round's row change shrinks by the view's motion over the
+        // readout, a few percent of the frame).
+        for (int round = 0; rolling && round < 8; ++round) {
+          const Pose2D at = pose_after(view, robot, row_time_s(view.intrinsics, *v));
+          if (!project_world_point(view.intrinsics, camera_pose_from_robot(at, view.mount), p, u,
+                                   v))
+            return false;
+        }
+        return true;
       };
       auto inside = [&](double u, double v) {
         return u >= 0.0 && v >= 0.0 && u <= view.intrinsics.width - 1.0 &&

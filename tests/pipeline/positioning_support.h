@@ -19,7 +19,15 @@ struct SyntheticView {
   double noise_px = 0.0;
   uint64_t seed = 1;
   bool include_partial = false;  // also emit markers cut by the image border
+  // Rolling shutter (intrinsics.readout_ms > 0): the robot's velocity, m/s
+  // in its own frame (forward, left), and its yaw rate, held constant (a
+  // constant twist, integrated exactly): each point is projected from the
+  // robot's pose when its own row was exposed.
+  double forward_mps = 0.0, left_mps = 0.0, yaw_rate_radps = 0.0;
 };
+
+// The robot `tau_s` after `robot` under `view`'s constant twist, exactly.
+Pose2D pose_after(const SyntheticView& view, const Pose2D& robot, double tau_s);
 
 // All markers of the layout's grid whose outline is inside the image.
 std::vector<MarkerObservation> observe(const SyntheticView& view, const Pose2D& robot);
