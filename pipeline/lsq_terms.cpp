@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "core/small_angle.h"
 #include "core/small_matrix.h"
 
 namespace ceilpose {
@@ -39,8 +40,9 @@ void camera_at(const LsqState& st, double tau_s, Vec3* t_w, Mat3* r_wc) {
     *r_wc = st.r_wc;
     return;
   }
-  const double a = st.w * tau_s;
-  camera_at(st, tau_s, std::sin(a), std::cos(a), t_w, r_wc);
+  double sin_wt = 0.0, cos_wt = 1.0;
+  small_angle_sincos(st.w * tau_s, &sin_wt, &cos_wt);
+  camera_at(st, tau_s, sin_wt, cos_wt, t_w, r_wc);
 }
 
 // An edge point keeps only its residual's component across the edge, less
@@ -84,7 +86,8 @@ PointCamera point_camera(const LsqState& st, const LsqPoint& pt, const PointCame
   Vec3 t_w = st.t_w;
   if (pt.tau_s != 0.0) {
     // One sine and cosine for the camera's turn and its axes'.
-    const double a = st.w * pt.tau_s, sa = std::sin(a), ca = std::cos(a);
+    double sa = 0.0, ca = 1.0;
+    small_angle_sincos(st.w * pt.tau_s, &sa, &ca);
     Mat3 r_wc;
     camera_at(st, pt.tau_s, sa, ca, &t_w, &r_wc);
     cam.rt = mat_transpose(r_wc);
