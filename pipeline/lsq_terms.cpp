@@ -26,11 +26,15 @@ Mat3 turned(const Mat3& r, double s, double c) {
 
 // The camera when a point tau_s after the centre row was exposed: t moved
 // along its arc (v, w) and Exp(w·tau·z)·R, whose turn has sine sin_wt and cosine cos_wt.
-void camera_at(const LsqState& st, double tau_s, double sin_wt, double cos_wt, Vec3* t_w,
-               Mat3* r_wc) {
+Vec3 centre_at(const LsqState& st, double tau_s) {
   double dx_m = 0.0, dy_m = 0.0;
   arc_displacement(st.vx, st.vy, st.w, tau_s, &dx_m, &dy_m);
-  *t_w = {st.t_w[0] + dx_m, st.t_w[1] + dy_m, st.t_w[2]};
+  return {st.t_w[0] + dx_m, st.t_w[1] + dy_m, st.t_w[2]};
+}
+
+void camera_at(const LsqState& st, double tau_s, double sin_wt, double cos_wt, Vec3* t_w,
+               Mat3* r_wc) {
+  *t_w = centre_at(st, tau_s);
   *r_wc = turned(st.r_wc, sin_wt, cos_wt);
 }
 
@@ -88,9 +92,13 @@ PointCamera point_camera(const LsqState& st, const LsqPoint& pt, const PointCame
     // One sine and cosine for the camera's turn and its axes'.
     double sa = 0.0, ca = 1.0;
     small_angle_sincos(st.w * pt.tau_s, &sa, &ca);
-    Mat3 r_wc;
-    camera_at(st, pt.tau_s, sa, ca, &t_w, &r_wc);
-    cam.rt = mat_transpose(r_wc);
+    t_w = centre_at(st, pt.tau_s);
+    // turned()'s rows of R are Rᵀ's columns: the same products, in place.
+    for (int i = 0; i < 3; ++i) {
+      const double c0 = centre.rt[3 * i], c1 = centre.rt[3 * i + 1];
+      cam.rt[3 * i] = ca * c0 - sa * c1;
+      cam.rt[3 * i + 1] = sa * c0 + ca * c1;
+    }
     if (with_axes) {
       // The turn about the vertical turns the level axes with it; the yaw
       // axis stays vertical.
