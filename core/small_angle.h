@@ -5,8 +5,10 @@
 // camera by (3 rad/s over half a 33 ms readout: 0.05 rad), which the
 // least-squares solver needs per point per pass: a Taylor series to the
 // 9th / 10th power is within an ulp or two of std::sin / std::cos up to
-// kSmallAngle_rad (the next terms are below 3e-17) in a tenth of their
-// instructions; larger angles take std::sin / std::cos.
+// kSmallAngle_rad (the next terms are below 3e-17) in a dozen
+// multiplications and additions (a rolling-shutter tracked frame: 3.5 %
+// fewer instructions than with the library's); larger angles take
+// std::sin / std::cos.
 
 namespace ceilpose {
 

@@ -13,8 +13,8 @@ constexpr int kN = kLsqParams;
 
 // Rotation by an angle of sine s and cosine c about the world's vertical,
 // applied on the left: only the first two rows mix, and the third stays
-// (a full product's 27 multiplications, 15 of them by 0 or 1, were 5 % of
-// a rolling-shutter frame's instructions).
+// (a full 3×3 product, 15 of whose 27 multiplications are by 0 or 1, cost
+// a rolling-shutter tracked frame 2 % more instructions).
 Mat3 turned(const Mat3& r, double s, double c) {
   Mat3 out = r;
   for (int j = 0; j < 3; ++j) {
@@ -24,14 +24,16 @@ Mat3 turned(const Mat3& r, double s, double c) {
   return out;
 }
 
-// The camera when a point tau_s after the centre row was exposed: t moved
-// along its arc (v, w) and Exp(w·tau·z)·R, whose turn has sine sin_wt and cosine cos_wt.
+// The optical centre when a point tau_s after the centre row was exposed:
+// t moved along its arc (v, w).
 Vec3 centre_at(const LsqState& st, double tau_s) {
   double dx_m = 0.0, dy_m = 0.0;
   arc_displacement(st.vx, st.vy, st.w, tau_s, &dx_m, &dy_m);
   return {st.t_w[0] + dx_m, st.t_w[1] + dy_m, st.t_w[2]};
 }
 
+// The camera then: centre_at's, and Exp(w·tau·z)·R, whose turn has sine
+// sin_wt and cosine cos_wt.
 void camera_at(const LsqState& st, double tau_s, double sin_wt, double cos_wt, Vec3* t_w,
                Mat3* r_wc) {
   *t_w = centre_at(st, tau_s);
@@ -93,7 +95,8 @@ PointCamera point_camera(const LsqState& st, const LsqPoint& pt, const PointCame
     double sa = 0.0, ca = 1.0;
     small_angle_sincos(st.w * pt.tau_s, &sa, &ca);
     t_w = centre_at(st, pt.tau_s);
-    // turned()'s rows of R are Rᵀ's columns: the same products, in place.
+    // turned() mixes R's first two rows, which are Rᵀ's first two columns:
+    // the same products, on the centre row's Rᵀ in place.
     for (int i = 0; i < 3; ++i) {
       const double c0 = centre.rt[3 * i], c1 = centre.rt[3 * i + 1];
       cam.rt[3 * i] = ca * c0 - sa * c1;
