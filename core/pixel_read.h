@@ -8,6 +8,7 @@
 #include <algorithm>
 #include <array>
 #include <atomic>
+#include <cmath>
 #include <cstddef>
 #include <cstdint>
 #include <type_traits>
@@ -36,6 +37,19 @@ inline void yuv_to_rgb(int y, int u, int v, uint8_t* r, uint8_t* g, uint8_t* b) 
   *g = yuv_channel(c, p.g);
   *b = yuv_channel(c, p.b);
 }
+// RGB levels (0..255, fractional allowed) to BT.601 limited range, rounded:
+// yuv_to_rgb's inverse up to rounding. A simulated camera's conversion, and
+// where the classifier looks for the tile in a camera's bytes.
+struct Yuv {
+  uint8_t y, u, v;
+};
+inline Yuv rgb_to_yuv(double r, double g, double b) {
+  auto byte = [](double x) { return static_cast<uint8_t>(std::lround(std::clamp(x, 0.0, 255.0))); };
+  return {byte(16.0 + (65.481 * r + 128.553 * g + 24.966 * b) / 255.0),
+          byte(128.0 + (-37.797 * r - 74.203 * g + 112.0 * b) / 255.0),
+          byte(128.0 + (112.0 * r - 93.786 * g - 18.214 * b) / 255.0)};
+}
+
 // The darkest of the three channels yuv_to_rgb gives, without the three: a
 // channel rises with its chroma part (clamp and shift keep order), so the
 // darkest is the one with the least.

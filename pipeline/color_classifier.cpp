@@ -125,6 +125,7 @@ void ColorClassifier::set_params(const DetectorParams& params, Rgb tile) {
         lut_[idx] = static_cast<uint8_t>(classify_normalised(
             qr * kStep + kStep / 2, qg * kStep + kStep / 2, qb * kStep + kStep / 2));
       }
+  background_cells_.build(lut_.data(), kBitsPerChannel);
   // 255 / sum in 16 fractional bits: two chromaticities per tile sample
   // without a division.
   chroma_scale_[0] = 0;
@@ -145,6 +146,9 @@ void ColorClassifier::set_gains(const std::array<float, 3>& gains) {
       tables_[c][level] = static_cast<uint32_t>(norm >> kShift) << place;
     }
   }
+  // Around the raw colour these gains take to the nominal tile: the tile.
+  const Yuv tile = rgb_to_yuv(tile_.r / gains_[0], tile_.g / gains_[1], tile_.b / gains_[2]);
+  background_yuv_ = background_cells_.grow({table(0), table(1), table(2)}, tile.y, tile.u, tile.v);
 }
 
 void ColorClassifier::use_default_normalisation() {

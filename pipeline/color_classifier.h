@@ -11,6 +11,7 @@
 #include "core/ceiling_layout.h"
 #include "core/image.h"
 #include "core/pixel_read.h"
+#include "pipeline/background_box.h"
 #include "pipeline/detector_params.h"
 
 namespace ceilpose {
@@ -54,6 +55,11 @@ class ColorClassifier {
   const std::array<float, 3>& reference() const { return reference_; }
   void set_gains(const std::array<float, 3>& gains);
 
+  // Camera YUV bytes (BT.601, a sample's own chroma) that are background
+  // under the current gains, around the tile's colour; proven with every
+  // set_gains (pipeline/background_box.h). Empty when none is.
+  const YuvBox& background_yuv() const { return background_yuv_; }
+
  private:
   void use_default_normalisation();
   uint32_t sample_candidates(const ImageView& frame, std::array<uint32_t, 256>* level_count,
@@ -66,6 +72,8 @@ class ColorClassifier {
   std::array<std::array<uint32_t, 256>, 3> tables_{};
   std::array<float, 3> gains_{1.0f, 1.0f, 1.0f};
   std::array<float, 3> reference_{};
+  BackgroundCells background_cells_;
+  YuvBox background_yuv_;
   std::array<uint32_t, 3 * 255 + 1> chroma_scale_{};
   // Tile candidates of the current frame's sample grid, R | G << 8 | B << 16.
   std::array<uint32_t, 8192> samples_{};

@@ -114,6 +114,73 @@ CEILPOSE_VECTOR_CLONES void planar_sampled(const uint8_t* __restrict q, int pair
   }
 }
 
+// in[i] = 1 where the i-th of every `kPairs`-th YUYV pixel pair's first
+// pixel (own chroma) lies in `box`.
+template <int kPairs>
+CEILPOSE_VECTOR_CLONES void yuyv_in_box(const uint8_t* __restrict q, YuvBox box,
+                                        uint8_t* __restrict in, int n) {
+  const auto y_span = static_cast<uint8_t>(box.y_hi - box.y_lo);
+  const auto u_span = static_cast<uint8_t>(box.u_hi - box.u_lo);
+  const auto v_span = static_cast<uint8_t>(box.v_hi - box.v_lo);
+  for (int i = 0; i < n; ++i) {
+    uint32_t w = 0;
+    std::memcpy(&w, q + 4 * kPairs * i, sizeof w);
+    const auto y = static_cast<uint8_t>(static_cast<uint8_t>(w) - box.y_lo);
+    const auto u = static_cast<uint8_t>(static_cast<uint8_t>(w >> 8) - box.u_lo);
+    const auto v = static_cast<uint8_t>(static_cast<uint8_t>(w >> 24) - box.v_lo);
+    in[i] = static_cast<uint8_t>((y <= y_span) & (u <= u_span) & (v <= v_span));
+  }
+}
+
+// The same from 4:2:0 planes: luma every kLumaStep bytes, chroma every
+// kChromaStep bytes of its plane (NV12's interleaved U and V are one byte
+// apart, I420's in planes of their own).
+template <int kLumaStep, int kChromaStep>
+CEILPOSE_VECTOR_CLONES void planar_in_box(const uint8_t* __restrict q, const uint8_t* __restrict u,
+                                          const uint8_t* __restrict v, YuvBox box,
+                                          uint8_t* __restrict in, int n) {
+  const auto y_span = static_cast<uint8_t>(box.y_hi - box.y_lo);
+  const auto u_span = static_cast<uint8_t>(box.u_hi - box.u_lo);
+  const auto v_span = static_cast<uint8_t>(box.v_hi - box.v_lo);
+  for (int i = 0; i < n; ++i) {
+    const auto y = static_cast<uint8_t>(q[kLumaStep * i] - box.y_lo);
+    const auto cu = static_cast<uint8_t>(u[kChromaStep * i] - box.u_lo);
+    const auto cv = static_cast<uint8_t>(v[kChromaStep * i] - box.v_lo);
+    in[i] = static_cast<uint8_t>((y <= y_span) & (cu <= u_span) & (cv <= v_span));
+  }
+}
+
+// Calls convert(begin, end) on the stretches of [0, count) that are not
+// whole blocks of kBoxBlock samples in the box (`in`, padded past count).
+// A block is as long as an AVX2 vector of int16: a stretch is then whole
+// vectors for the conversion, not a scalar remainder (8-sample blocks
+// skipped 79 % of the samples yet saved the conversion only 31 %).
+constexpr int kBoxBlock = 16;
+template <typename Convert>
+void outside_box(const uint8_t* in, int count, Convert&& convert) {
+  constexpr uint64_t kAllIn = 0x0101010101010101ull;
+  auto block_in = [&](int i) {
+    if (i + kBoxBlock > count) return false;
+    uint64_t w[kBoxBlock / 8];
+    std::memcpy(w, in + i, sizeof w);
+    uint64_t all = kAllIn;
+    for (const uint64_t x : w) all &= x == kAllIn ? kAllIn : 0;
+    return all == kAllIn;
+  };
+  int i = 0;
+  while (i < count) {
+    if (block_in(i)) {
+      i += kBoxBlock;
+      continue;
+    }
+    int end = i + kBoxBlock;
+    while (end < count && !block_in(end)) end += kBoxBlock;
+    end = std::min(end, count);
+    convert(i, end);
+    i = end;
+  }
+}
+
 // BT.601 (video range) from luma and chroma x16 to 0..255 levels, in ints
 // scaled by 2^12. A function of its own so that the compiler knows the
 // arrays do not overlap and vectorises the loop.
@@ -197,7 +264,7 @@ void ComponentLabeler::resize(int width_px, int height_px) {
   const size_t pairs_padded = static_cast<size_t>(width_ / 2) + kRowPadding;
   for (auto* v : {&pair_u_, &pair_v_}) v->assign(pairs_padded, 0);
   for (auto* v : {&px_y_, &px_u_, &px_v_}) v->assign(pixels_padded, 0);
-  for (auto* v : {&px_r_, &px_g_, &px_b_}) v->assign(pixels_padded, 0);
+  for (auto* v : {&px_r_, &px_g_, &px_b_, &in_box_}) v->assign(pixels_padded, 0);
   spans_.resize(static_cast<size_t>(height_) * kReservedSpansPerRow);
   swept_.reserve(kReservedSpansPerRow);
   runs_.resize(static_cast<size_t>(max_runs_) + 1);
@@ -587,15 +654,44 @@ void ComponentLabeler::classify_sampled_row(const ImageView& frame, int y, int s
       int16_t* py = px_y_.data();
       int16_t* pu = px_u_.data();
       int16_t* pv = px_v_.data();
-      if (frame.format == PixelFormat::kYuyv) {
-        yuyv_sampled(row, pairs, py, pu, pv, count);
-      } else if (frame.format == PixelFormat::kNv12) {
-        planar_sampled(row, pairs, frame.uv_row(y), frame.uv_row(y) + 1, 2, py, pu, pv, count);
-      } else {
-        planar_sampled(row, pairs, frame.u_row(y), frame.v_row(y), 1, py, pu, pv, count);
+      const bool nv12 = frame.format == PixelFormat::kNv12;
+      // Each sample's chroma: YUYV's in its pair, 4:2:0's in its chroma row
+      // (NV12's U and V interleaved, I420's in planes).
+      const int chroma_step = nv12 ? 2 : 1;
+      const uint8_t* u = frame.format == PixelFormat::kYuyv ? nullptr
+                         : nv12                             ? frame.uv_row(y)
+                                                            : frame.u_row(y);
+      const uint8_t* v = frame.format == PixelFormat::kYuyv ? nullptr
+                         : nv12                             ? frame.uv_row(y) + 1
+                                                            : frame.v_row(y);
+      auto convert = [&](int b, int e) {
+        if (frame.format == PixelFormat::kYuyv) {
+          yuyv_sampled(row + 4 * pairs * b, pairs, py + b, pu + b, pv + b, e - b);
+        } else {
+          const int c = chroma_step * pairs * b;
+          planar_sampled(row + 2 * pairs * b, pairs, u + c, v + c, chroma_step, py + b, pu + b,
+                         pv + b, e - b);
+        }
+        bt601_levels(py + b, pu + b, pv + b, px_r_.data() + b, px_g_.data() + b, px_b_.data() + b,
+                     e - b);
+        lookup_levels(px_r_.data() + b, px_g_.data() + b, px_b_.data() + b, classifier, out + b,
+                      e - b);
+      };
+      const YuvBox& box = classifier.background_yuv();
+      if (box.empty()) {
+        convert(0, count);
+        return;
       }
-      bt601_levels(py, pu, pv, px_r_.data(), px_g_.data(), px_b_.data(), count);
-      lookup_levels(px_r_.data(), px_g_.data(), px_b_.data(), classifier, out, count);
+      uint8_t* in = in_box_.data();
+      const bool two = pairs == 2;
+      if (frame.format == PixelFormat::kYuyv) {
+        (two ? yuyv_in_box<2> : yuyv_in_box<1>)(row, box, in, count);
+      } else if (nv12) {
+        (two ? planar_in_box<4, 4> : planar_in_box<2, 2>)(row, u, v, box, in, count);
+      } else {
+        (two ? planar_in_box<4, 2> : planar_in_box<2, 1>)(row, u, v, box, in, count);
+      }
+      outside_box(in, count, convert);
       return;
     }
     case PixelFormat::kGray8:

@@ -140,6 +140,9 @@ class ComponentLabeler {
   std::vector<int16_t> pair_u_, pair_v_;
   std::vector<int16_t> px_y_, px_u_, px_v_;
   std::vector<uint8_t> px_r_, px_g_, px_b_;
+  // Per sample of a sampled row: 1 where it lies in the classifier's
+  // background box (nothing to convert or look up).
+  std::vector<uint8_t> in_box_;
   struct RowSpan {
     int x0 = 0, x1 = -1;  // x1 < x0: none
   };

@@ -3,22 +3,16 @@
 #include <algorithm>
 #include <cmath>
 
+#include "core/pixel_read.h"
+
 namespace ceilpose::sim {
 
 namespace {
 
-// BT.601 limited range, V4L2's default quantisation.
-uint8_t luma(double r, double g, double b) {
-  return static_cast<uint8_t>(std::lround(16.0 + (65.481 * r + 128.553 * g + 24.966 * b) / 255.0));
-}
-uint8_t chroma_u(double r, double g, double b) {
-  return static_cast<uint8_t>(
-      std::lround(std::clamp(128.0 + (-37.797 * r - 74.203 * g + 112.0 * b) / 255.0, 0.0, 255.0)));
-}
-uint8_t chroma_v(double r, double g, double b) {
-  return static_cast<uint8_t>(
-      std::lround(std::clamp(128.0 + (112.0 * r - 93.786 * g - 18.214 * b) / 255.0, 0.0, 255.0)));
-}
+// BT.601 limited range, V4L2's default quantisation (core/pixel_read.h).
+uint8_t luma(double r, double g, double b) { return rgb_to_yuv(r, g, b).y; }
+uint8_t chroma_u(double r, double g, double b) { return rgb_to_yuv(r, g, b).u; }
+uint8_t chroma_v(double r, double g, double b) { return rgb_to_yuv(r, g, b).v; }
 
 // 4:2:0: luma per pixel, U and V of each 2x2 block's mean colour, in the
 // layouts of core/image.h.

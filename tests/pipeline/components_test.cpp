@@ -293,6 +293,78 @@ TEST_F(ComponentsTest, HalvedSweepOfYuvFramesGivesTheRgbFramesRectangles) {
   }
 }
 
+// A halved or quartered sweep of YUYV, NV12 and I420 classifies each sample
+// exactly as its own BT.601 levels (its pair's or chroma row's chroma) do,
+// whether or not the sample lies in the classifier's background box and is
+// left unconverted: tile with a camera's read noise (in the box), noise
+// that leaves it, markers, a dot and saturated colour, with and without a
+// colour cast that the gains undo.
+TEST_F(ComponentsTest, SampledYuvSweepClassifiesEachSampleAsItsOwnLevelsDo) {
+  fill(10, 20, 29, 59, kRed);
+  fill(61, 11, 84, 40, kGreen);
+  fill(66, 20, 71, 25, kDot);
+  fill(100, 50, 119, 89, {255, 0, 0});
+  std::mt19937 rng(5);
+  std::normal_distribution<double> read_noise(0.0, 2.0);
+  std::uniform_int_distribution<int> wild(-60, 60);
+  for (int y = 0; y < kHeight; ++y) {
+    for (int x = 0; x < kWidth; ++x) {
+      uint8_t* p = frame.row(y) + 3 * x;
+      const bool noisy = y >= 70 && x < 50;  // a patch of strong noise
+      for (int k = 0; k < 3; ++k) {
+        const double n = noisy ? wild(rng) : read_noise(rng);
+        p[k] = static_cast<uint8_t>(std::clamp(static_cast<int>(std::lround(p[k] + n)), 0, 255));
+      }
+    }
+  }
+  const Image plain = frame;
+  for (const std::array<float, 3> cast :
+       {std::array<float, 3>{1.0f, 1.0f, 1.0f}, std::array<float, 3>{0.85f, 1.05f, 1.2f}}) {
+    for (int y = 0; y < kHeight; ++y)
+      for (int x = 0; x < kWidth * 3; ++x)
+        frame.row(y)[x] = static_cast<uint8_t>(
+            std::min(255.0f, std::round(plain.view().row(y)[x] * cast[x % 3])));
+    const std::array<float, 3> gains{1 / cast[0], 1 / cast[1], 1 / cast[2]};
+    classifier.set_gains(gains);
+    ASSERT_FALSE(classifier.background_yuv().empty());
+    for (PixelFormat format : {PixelFormat::kYuyv, PixelFormat::kNv12, PixelFormat::kYuv420}) {
+      const Image yuv = test::convert_rgb(frame, format);
+      Image levels(kWidth, kHeight, PixelFormat::kRgb24);
+      int in_box = 0;
+      for (int y = 0; y < kHeight; ++y)
+        for (int x = 0; x < kWidth; ++x) {
+          uint8_t r = 0, g = 0, b = 0;
+          read_rgb(yuv.view(), x, y, &r, &g, &b);
+          test::put_rgb(&levels, x, y, {r, g, b});
+          const uint8_t* q = yuv.view().row(y);
+          if (format == PixelFormat::kYuyv && x % 2 == 0)
+            in_box += classifier.background_yuv().contains(q[2 * x], q[2 * x + 1], q[2 * x + 3]);
+        }
+      if (format == PixelFormat::kYuyv) {
+        EXPECT_GT(in_box, kWidth * kHeight / 4) << "most tile pixels are in the box";
+        EXPECT_LT(in_box, kWidth * kHeight / 2) << "markers and the noisy patch are not";
+      }
+      for (int step : {2, 4}) {
+        SCOPED_TRACE(testing::Message() << to_string(format) << " step " << step << " gains "
+                                        << gains[0] << " " << gains[1] << " " << gains[2]);
+        ASSERT_TRUE(labeler.label_sampled(levels.view(), classifier, step));
+        const std::vector<Component> want(labeler.components().begin(), labeler.components().end());
+        ASSERT_TRUE(labeler.label_sampled(yuv.view(), classifier, step));
+        const auto got = labeler.components();
+        ASSERT_GE(want.size(), 3u);
+        ASSERT_EQ(got.size(), want.size());
+        for (size_t k = 0; k < want.size(); ++k) {
+          EXPECT_EQ(got[k].cls, want[k].cls) << k;
+          EXPECT_EQ(got[k].area_px, want[k].area_px) << k;
+          EXPECT_EQ(got[k].dark_px, want[k].dark_px) << k;
+          EXPECT_DOUBLE_EQ(got[k].cx, want[k].cx) << k;
+          EXPECT_DOUBLE_EQ(got[k].cy, want[k].cy) << k;
+        }
+      }
+    }
+  }
+}
+
 TEST_F(ComponentsTest, HalvedSweepRefusesNoiseAnotherSizeAndFindsNothingInGrey) {
   fill(10, 20, 29, 59, kRed);
   const Image grey = test::convert_rgb(frame, PixelFormat::kGray8);
