@@ -170,20 +170,23 @@ uint32_t ColorClassifier::sample_candidates(const ImageView& frame,
     ++step;
   uint32_t candidates = 0;
   *total = 0;
-  for (int y = step / 2; y < frame.height; y += step)
-    for (int x = step / 2; x < frame.width; x += step) {
-      uint8_t r = 0, g = 0, b = 0;
-      read_rgb(frame, x, y, &r, &g, &b);
-      ++*total;
-      const int v = std::max({r, g, b});
-      const int m = std::min({r, g, b});
-      // Saturation (v - m) / v at most kMaxTileSaturationNum / Den.
-      if (v < kMinSampleLevel || (v - m) * kMaxTileSaturationDen > v * kMaxTileSaturationNum)
-        continue;
-      ++(*level_count)[(r + g + b) / 3];
-      samples_[candidates++] =
-          static_cast<uint32_t>(r) | static_cast<uint32_t>(g) << 8 | static_cast<uint32_t>(b) << 16;
-    }
+  // One dispatch on the format for the frame's grid (MJPEG: no pixels).
+  with_pixel_reader(frame.format, [&](auto read) {
+    for (int y = step / 2; y < frame.height; y += step)
+      for (int x = step / 2; x < frame.width; x += step) {
+        const Rgb c = read(frame, x, y);
+        const int r = c.r, g = c.g, b = c.b;
+        ++*total;
+        const int v = std::max({r, g, b});
+        const int m = std::min({r, g, b});
+        // Saturation (v - m) / v at most kMaxTileSaturationNum / Den.
+        if (v < kMinSampleLevel || (v - m) * kMaxTileSaturationDen > v * kMaxTileSaturationNum)
+          continue;
+        ++(*level_count)[(r + g + b) / 3];
+        samples_[candidates++] = static_cast<uint32_t>(r) | static_cast<uint32_t>(g) << 8 |
+                                 static_cast<uint32_t>(b) << 16;
+      }
+  });
   return candidates;
 }
 
