@@ -114,21 +114,36 @@ CEILPOSE_VECTOR_CLONES void planar_sampled(const uint8_t* __restrict q, int pair
   }
 }
 
+// A byte x is in [lo, hi] when uint8_t(x - lo) <= hi - lo: one subtraction
+// and one comparison, which vectorise.
+struct BoxTest {
+  explicit BoxTest(const YuvBox& b)
+      : y_lo(b.y_lo),
+        y_span(static_cast<uint8_t>(b.y_hi - b.y_lo)),
+        u_lo(b.u_lo),
+        u_span(static_cast<uint8_t>(b.u_hi - b.u_lo)),
+        v_lo(b.v_lo),
+        v_span(static_cast<uint8_t>(b.v_hi - b.v_lo)) {}
+  static bool within(uint8_t x, uint8_t lo, uint8_t span) {
+    return static_cast<uint8_t>(x - lo) <= span;
+  }
+  bool y(uint8_t x) const { return within(x, y_lo, y_span); }
+  bool u(uint8_t x) const { return within(x, u_lo, u_span); }
+  bool v(uint8_t x) const { return within(x, v_lo, v_span); }
+  uint8_t y_lo, y_span, u_lo, u_span, v_lo, v_span;
+};
+
 // in[i] = 1 where the i-th of every `kPairs`-th YUYV pixel pair's first
 // pixel (own chroma) lies in `box`.
 template <int kPairs>
 CEILPOSE_VECTOR_CLONES void yuyv_in_box(const uint8_t* __restrict q, YuvBox box,
                                         uint8_t* __restrict in, int n) {
-  const auto y_span = static_cast<uint8_t>(box.y_hi - box.y_lo);
-  const auto u_span = static_cast<uint8_t>(box.u_hi - box.u_lo);
-  const auto v_span = static_cast<uint8_t>(box.v_hi - box.v_lo);
+  const BoxTest t(box);
   for (int i = 0; i < n; ++i) {
     uint32_t w = 0;
     std::memcpy(&w, q + 4 * kPairs * i, sizeof w);
-    const auto y = static_cast<uint8_t>(static_cast<uint8_t>(w) - box.y_lo);
-    const auto u = static_cast<uint8_t>(static_cast<uint8_t>(w >> 8) - box.u_lo);
-    const auto v = static_cast<uint8_t>(static_cast<uint8_t>(w >> 24) - box.v_lo);
-    in[i] = static_cast<uint8_t>((y <= y_span) & (u <= u_span) & (v <= v_span));
+    in[i] = static_cast<uint8_t>(t.y(static_cast<uint8_t>(w)) & t.u(static_cast<uint8_t>(w >> 8)) &
+                                 t.v(static_cast<uint8_t>(w >> 24)));
   }
 }
 
@@ -139,14 +154,41 @@ template <int kLumaStep, int kChromaStep>
 CEILPOSE_VECTOR_CLONES void planar_in_box(const uint8_t* __restrict q, const uint8_t* __restrict u,
                                           const uint8_t* __restrict v, YuvBox box,
                                           uint8_t* __restrict in, int n) {
-  const auto y_span = static_cast<uint8_t>(box.y_hi - box.y_lo);
-  const auto u_span = static_cast<uint8_t>(box.u_hi - box.u_lo);
-  const auto v_span = static_cast<uint8_t>(box.v_hi - box.v_lo);
+  const BoxTest t(box);
   for (int i = 0; i < n; ++i) {
-    const auto y = static_cast<uint8_t>(q[kLumaStep * i] - box.y_lo);
-    const auto cu = static_cast<uint8_t>(u[kChromaStep * i] - box.u_lo);
-    const auto cv = static_cast<uint8_t>(v[kChromaStep * i] - box.v_lo);
-    in[i] = static_cast<uint8_t>((y <= y_span) & (cu <= u_span) & (cv <= v_span));
+    in[i] = static_cast<uint8_t>(t.y(q[kLumaStep * i]) & t.u(u[kChromaStep * i]) &
+                                 t.v(v[kChromaStep * i]));
+  }
+}
+
+// in[k] = 1 where YUYV pixel pair k (both lumas, its chroma) lies in
+// `box`, for the n pairs from q.
+CEILPOSE_VECTOR_CLONES void yuyv_pairs_in_box(const uint8_t* __restrict q, YuvBox box,
+                                              uint8_t* __restrict in, int n) {
+  const BoxTest t(box);
+  for (int k = 0; k < n; ++k) {
+    uint32_t w = 0;
+    std::memcpy(&w, q + 4 * k, sizeof w);
+    in[k] = static_cast<uint8_t>(t.y(static_cast<uint8_t>(w)) & t.u(static_cast<uint8_t>(w >> 8)) &
+                                 t.y(static_cast<uint8_t>(w >> 16)) &
+                                 t.v(static_cast<uint8_t>(w >> 24)));
+  }
+}
+// The same for 4:2:0 pairs: both lumas, and the chroma of both chroma rows
+// a pixel's chroma mixes (`near`, `far`; U and V kChromaStep bytes apart
+// along a row: NV12 2, I420 1).
+template <int kChromaStep>
+CEILPOSE_VECTOR_CLONES void planar_pairs_in_box(const uint8_t* __restrict q,
+                                                const uint8_t* __restrict u_near,
+                                                const uint8_t* __restrict v_near,
+                                                const uint8_t* __restrict u_far,
+                                                const uint8_t* __restrict v_far, YuvBox box,
+                                                uint8_t* __restrict in, int n) {
+  const BoxTest t(box);
+  for (int k = 0; k < n; ++k) {
+    in[k] = static_cast<uint8_t>(t.y(q[2 * k]) & t.y(q[2 * k + 1]) & t.u(u_near[kChromaStep * k]) &
+                                 t.v(v_near[kChromaStep * k]) & t.u(u_far[kChromaStep * k]) &
+                                 t.v(v_far[kChromaStep * k]));
   }
 }
 
@@ -339,12 +381,64 @@ void ComponentLabeler::classify_span(const ImageView& frame, int y, int x0, int 
     case PixelFormat::kYuyv:
     case PixelFormat::kNv12:
     case PixelFormat::kYuv420:
-      classify_yuv_span(frame, y, x0, x1, classifier);
+      classify_yuv_span_outside_box(frame, y, x0, x1, classifier);
       return;
     case PixelFormat::kGray8:
     case PixelFormat::kMjpeg:
       std::memset(out + x0, 0, static_cast<size_t>(x1 - x0 + 1));
       return;
+  }
+}
+
+void ComponentLabeler::classify_yuv_span_outside_box(const ImageView& frame, int y, int x0, int x1,
+                                                     const ColorClassifier& classifier) {
+  const YuvBox& box = classifier.background_yuv();
+  if (box.empty()) {
+    classify_yuv_span(frame, y, x0, x1, classifier);
+    return;
+  }
+  // A pixel's chroma mixes its pair's with a neighbouring pair's (4:2:0:
+  // also with the neighbouring chroma row's), and lies between them: a
+  // pixel is background when its pair and both neighbours (clamped to the
+  // frame, as classify_yuv_span clamps) are in the box, chroma rows and all.
+  const int last_pair = (frame.width - 1) >> 1;
+  const int k0 = std::max((x0 >> 1) - 1, 0), k1 = std::min((x1 >> 1) + 1, last_pair);
+  uint8_t* in = in_box_.data();  // in[k - k0] for pair k
+  const uint8_t* row = frame.row(y);
+  if (frame.format == PixelFormat::kYuyv) {
+    yuyv_pairs_in_box(row + 4 * k0, box, in, k1 - k0 + 1);
+  } else {
+    const int y_other = chroma_neighbour_row(y, frame.height);
+    if (frame.format == PixelFormat::kNv12) {
+      planar_pairs_in_box<2>(row + 2 * k0, frame.uv_row(y) + 2 * k0, frame.uv_row(y) + 2 * k0 + 1,
+                             frame.uv_row(y_other) + 2 * k0, frame.uv_row(y_other) + 2 * k0 + 1,
+                             box, in, k1 - k0 + 1);
+    } else {
+      planar_pairs_in_box<1>(row + 2 * k0, frame.u_row(y) + k0, frame.v_row(y) + k0,
+                             frame.u_row(y_other) + k0, frame.v_row(y_other) + k0, box, in,
+                             k1 - k0 + 1);
+    }
+  }
+  // Blocks of kBoxBlock pixels from x0: skipped when every pair they touch
+  // and those pairs' neighbours are in the box; the rest converted in
+  // stretches.
+  auto block_in = [&](int b) {
+    const int e = std::min(b + kBoxBlock - 1, x1);
+    const int lo = std::max((b >> 1) - 1, 0), hi = std::min((e >> 1) + 1, last_pair);
+    uint8_t all = 1;
+    for (int k = lo; k <= hi; ++k) all &= in[k - k0];
+    return all != 0;
+  };
+  int b = x0;
+  while (b <= x1) {
+    if (block_in(b)) {
+      b += kBoxBlock;
+      continue;
+    }
+    int e = b + kBoxBlock;
+    while (e <= x1 && !block_in(e)) e += kBoxBlock;
+    classify_yuv_span(frame, y, b, std::min(e - 1, x1), classifier);
+    b = e;
   }
 }
 

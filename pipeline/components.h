@@ -102,6 +102,10 @@ class ComponentLabeler {
                      const ColorClassifier& classifier);
   void classify_yuv_span(const ImageView& frame, int y, int x0, int x1,
                          const ColorClassifier& classifier);
+  // The same, converting only the blocks of pixels not proven background
+  // by the classifier's box (their classes stay 0).
+  void classify_yuv_span_outside_box(const ImageView& frame, int y, int x0, int x1,
+                                     const ColorClassifier& classifier);
   // Pixels (step_px·i, y), i < count, into row_class_[i]: each pixel with
   // its pair's own chroma (4:2:0: its chroma row's), no interpolation.
   void classify_sampled_row(const ImageView& frame, int y, int step_px, int count,
@@ -140,8 +144,9 @@ class ComponentLabeler {
   std::vector<int16_t> pair_u_, pair_v_;
   std::vector<int16_t> px_y_, px_u_, px_v_;
   std::vector<uint8_t> px_r_, px_g_, px_b_;
-  // Per sample of a sampled row: 1 where it lies in the classifier's
-  // background box (nothing to convert or look up).
+  // Per sample of a sampled row (per pixel pair of a full-resolution
+  // span): 1 where it lies in the classifier's background box (nothing to
+  // convert or look up).
   std::vector<uint8_t> in_box_;
   struct RowSpan {
     int x0 = 0, x1 = -1;  // x1 < x0: none

@@ -188,13 +188,20 @@ TEST_F(ComponentsTest, YuvFramesClassifyEveryPixelAsItsBt601LevelsDo) {
   fill(61, 11, 84, 40, kGreen);
   fill(66, 20, 71, 25, kDot);
   fill(100, 50, 119, 89, {255, 0, 0});  // saturated: the clamps
+  // One pixel pair wide and one chroma row high: a neighbour's chroma takes
+  // a quarter of theirs, enough to make a tile pixel green.
+  fill(32, 2, 33, 40, {0, 255, 0});
+  fill(88, 30, 118, 31, {0, 255, 0});
+  // Strong noise on the lower half; above it a camera's read noise, which
+  // leaves most tile pixels in the classifier's background box (skipped).
   std::mt19937 rng(7);
-  std::uniform_int_distribution<int> noise(-40, 40);
+  std::uniform_int_distribution<int> noise(-40, 40), read_noise(-2, 2);
   for (int y = 0; y < kHeight; ++y) {
     for (int x = 0; x < kWidth; ++x) {
       uint8_t* p = frame.row(y) + 3 * x;
       for (int k = 0; k < 3; ++k)
-        p[k] = static_cast<uint8_t>(std::clamp(p[k] + noise(rng), 0, 255));
+        p[k] = static_cast<uint8_t>(
+            std::clamp(p[k] + (y >= kHeight / 2 ? noise(rng) : read_noise(rng)), 0, 255));
     }
   }
   for (PixelFormat format : {PixelFormat::kYuyv, PixelFormat::kNv12, PixelFormat::kYuv420}) {
@@ -204,6 +211,16 @@ TEST_F(ComponentsTest, YuvFramesClassifyEveryPixelAsItsBt601LevelsDo) {
     for (int y = 0; y < kHeight; ++y)
       for (int x = 0; x < kWidth; ++x)
         test::put_rgb(&levels, x, y, reference_levels(yuv.view(), x, y));
+    if (format == PixelFormat::kYuyv) {
+      int in_box = 0;
+      for (int y = 0; y < kHeight; ++y)
+        for (int x = 0; x < kWidth; x += 2) {
+          const uint8_t* q = yuv.view().row(y) + 2 * x;
+          const YuvBox& box = classifier.background_yuv();
+          in_box += 2 * (box.contains(q[0], q[1], q[3]) && box.contains(q[2], q[1], q[3]));
+        }
+      EXPECT_GT(in_box, kWidth * kHeight / 4) << "pixels whose pair is in the box";
+    }
     const PixelWindow windows[] = {{3, 7, 37, 66}, {55, 5, 91, 45}, {95, 45, 119, 89}};
     for (bool windowed : {false, true}) {
       SCOPED_TRACE(windowed ? "windows" : "whole");
