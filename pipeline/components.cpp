@@ -124,12 +124,14 @@ struct BoxTest {
         u_span(static_cast<uint8_t>(b.u_hi - b.u_lo)),
         v_lo(b.v_lo),
         v_span(static_cast<uint8_t>(b.v_hi - b.v_lo)) {}
-  static bool within(uint8_t x, uint8_t lo, uint8_t span) {
-    return static_cast<uint8_t>(x - lo) <= span;
+  // 1 or 0, not bool: callers combine tests with & to keep the loop
+  // branch-free (clang warns on & between bools).
+  static uint8_t within(uint8_t x, uint8_t lo, uint8_t span) {
+    return static_cast<uint8_t>(static_cast<uint8_t>(x - lo) <= span);
   }
-  bool y(uint8_t x) const { return within(x, y_lo, y_span); }
-  bool u(uint8_t x) const { return within(x, u_lo, u_span); }
-  bool v(uint8_t x) const { return within(x, v_lo, v_span); }
+  uint8_t y(uint8_t x) const { return within(x, y_lo, y_span); }
+  uint8_t u(uint8_t x) const { return within(x, u_lo, u_span); }
+  uint8_t v(uint8_t x) const { return within(x, v_lo, v_span); }
   uint8_t y_lo, y_span, u_lo, u_span, v_lo, v_span;
 };
 
