@@ -194,12 +194,30 @@ CEILPOSE_VECTOR_CLONES void planar_pairs_in_box(const uint8_t* __restrict q,
   }
 }
 
-// Calls convert(begin, end) on the stretches of [0, count) that are not
-// whole blocks of kBoxBlock samples in the box (`in`, padded past count).
-// A block is as long as an AVX2 vector of int16: a stretch is then whole
-// vectors for the conversion, not a scalar remainder (8-sample blocks
+// Calls convert(b, e) on the stretches of [begin, end) that are not whole
+// blocks of kBoxBlock samples in the box (block_in(b): the block from b
+// is). A block is as long as an AVX2 vector of int16: a stretch is then
+// whole vectors for the conversion, not a scalar remainder (8-sample blocks
 // skipped 79 % of the samples yet saved the conversion only 31 %).
 constexpr int kBoxBlock = 16;
+template <typename BlockIn, typename Convert>
+void convert_outside_box(int begin, int end, BlockIn&& block_in, Convert&& convert) {
+  int b = begin;
+  while (b < end) {
+    if (block_in(b)) {
+      b += kBoxBlock;
+      continue;
+    }
+    int e = b + kBoxBlock;
+    while (e < end && !block_in(e)) e += kBoxBlock;
+    e = std::min(e, end);
+    convert(b, e);
+    b = e;
+  }
+}
+
+// The same over samples flagged one by one (`in`, padded past count): a
+// block is in when its 16 flags are, and the last, partial block never is.
 template <typename Convert>
 void outside_box(const uint8_t* in, int count, Convert&& convert) {
   constexpr uint64_t kAllIn = 0x0101010101010101ull;
@@ -211,18 +229,7 @@ void outside_box(const uint8_t* in, int count, Convert&& convert) {
     for (const uint64_t x : w) all &= x == kAllIn ? kAllIn : 0;
     return all == kAllIn;
   };
-  int i = 0;
-  while (i < count) {
-    if (block_in(i)) {
-      i += kBoxBlock;
-      continue;
-    }
-    int end = i + kBoxBlock;
-    while (end < count && !block_in(end)) end += kBoxBlock;
-    end = std::min(end, count);
-    convert(i, end);
-    i = end;
-  }
+  convert_outside_box(0, count, block_in, convert);
 }
 
 // BT.601 (video range) from luma and chroma x16 to 0..255 levels, in ints
@@ -431,17 +438,8 @@ void ComponentLabeler::classify_yuv_span_outside_box(const ImageView& frame, int
     for (int k = lo; k <= hi; ++k) all &= in[k - k0];
     return all != 0;
   };
-  int b = x0;
-  while (b <= x1) {
-    if (block_in(b)) {
-      b += kBoxBlock;
-      continue;
-    }
-    int e = b + kBoxBlock;
-    while (e <= x1 && !block_in(e)) e += kBoxBlock;
-    classify_yuv_span(frame, y, b, std::min(e - 1, x1), classifier);
-    b = e;
-  }
+  convert_outside_box(x0, x1 + 1, block_in,
+                      [&](int b, int e) { classify_yuv_span(frame, y, b, e - 1, classifier); });
 }
 
 // Runs of row y between x0 and x1; the row buffer is zero outside the

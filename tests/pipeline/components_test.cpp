@@ -6,6 +6,7 @@
 #include <cmath>
 #include <numbers>
 #include <random>
+#include <span>
 #include <vector>
 
 #include "core/pixel_read.h"
@@ -17,6 +18,19 @@ namespace {
 constexpr Rgb kRed{200, 30, 40};
 constexpr Rgb kGreen{40, 160, 70};
 constexpr Rgb kDot{25, 25, 25};
+
+// The same components, each the same: class, area, dark pixels, centroid.
+void expect_same_components(std::span<const Component> got, std::span<const Component> want) {
+  ASSERT_GE(want.size(), 3u);
+  ASSERT_EQ(got.size(), want.size());
+  for (size_t k = 0; k < want.size(); ++k) {
+    EXPECT_EQ(got[k].cls, want[k].cls) << k;
+    EXPECT_EQ(got[k].area_px, want[k].area_px) << k;
+    EXPECT_EQ(got[k].dark_px, want[k].dark_px) << k;
+    EXPECT_DOUBLE_EQ(got[k].cx, want[k].cx) << k;
+    EXPECT_DOUBLE_EQ(got[k].cy, want[k].cy) << k;
+  }
+}
 
 class ComponentsTest : public ::testing::Test {
  protected:
@@ -231,15 +245,7 @@ TEST_F(ComponentsTest, YuvFramesClassifyEveryPixelAsItsBt601LevelsDo) {
         return std::vector<Component>(labeler.components().begin(), labeler.components().end());
       };
       const std::vector<Component> want = sweep(levels);
-      const std::vector<Component> got = sweep(yuv);
-      ASSERT_GE(want.size(), 3u);
-      ASSERT_EQ(got.size(), want.size());
-      for (size_t k = 0; k < want.size(); ++k) {
-        EXPECT_EQ(got[k].cls, want[k].cls) << k;
-        EXPECT_EQ(got[k].area_px, want[k].area_px) << k;
-        EXPECT_DOUBLE_EQ(got[k].cx, want[k].cx) << k;
-        EXPECT_DOUBLE_EQ(got[k].cy, want[k].cy) << k;
-      }
+      expect_same_components(sweep(yuv), want);
     }
   }
 }
@@ -367,16 +373,7 @@ TEST_F(ComponentsTest, SampledYuvSweepClassifiesEachSampleAsItsOwnLevelsDo) {
         ASSERT_TRUE(labeler.label_sampled(levels.view(), classifier, step));
         const std::vector<Component> want(labeler.components().begin(), labeler.components().end());
         ASSERT_TRUE(labeler.label_sampled(yuv.view(), classifier, step));
-        const auto got = labeler.components();
-        ASSERT_GE(want.size(), 3u);
-        ASSERT_EQ(got.size(), want.size());
-        for (size_t k = 0; k < want.size(); ++k) {
-          EXPECT_EQ(got[k].cls, want[k].cls) << k;
-          EXPECT_EQ(got[k].area_px, want[k].area_px) << k;
-          EXPECT_EQ(got[k].dark_px, want[k].dark_px) << k;
-          EXPECT_DOUBLE_EQ(got[k].cx, want[k].cx) << k;
-          EXPECT_DOUBLE_EQ(got[k].cy, want[k].cy) << k;
-        }
+        expect_same_components(labeler.components(), want);
       }
     }
   }
