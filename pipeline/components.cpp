@@ -1,6 +1,7 @@
 #include "pipeline/components.h"
 
 #include <algorithm>
+#include <bit>
 #include <cmath>
 #include <cstring>
 #include <tuple>
@@ -29,6 +30,12 @@ namespace ceilpose {
 namespace {
 
 constexpr size_t kRowPadding = 8;
+// Rows of classes are read eight bytes a word: a byte's value in every
+// lane, and the index of a word's first non-zero byte in memory order (the
+// word loaded from memory, not zero).
+static_assert(std::endian::native == std::endian::little, "bytes are read as little-endian words");
+constexpr uint64_t kByteOnes = 0x0101010101010101ull;
+int first_set_byte(uint64_t word) { return std::countr_zero(word) >> 3; }
 // Windows side by side that a sweep's span table holds without growing
 // (a tracked frame has one per marker in view, a dozen).
 constexpr size_t kReservedSpansPerRow = 32;
@@ -220,14 +227,13 @@ void convert_outside_box(int begin, int end, BlockIn&& block_in, Convert&& conve
 // block is in when its 16 flags are, and the last, partial block never is.
 template <typename Convert>
 void outside_box(const uint8_t* in, int count, Convert&& convert) {
-  constexpr uint64_t kAllIn = 0x0101010101010101ull;
   auto block_in = [&](int i) {
     if (i + kBoxBlock > count) return false;
     uint64_t w[kBoxBlock / 8];
     std::memcpy(w, in + i, sizeof w);
-    uint64_t all = kAllIn;
-    for (const uint64_t x : w) all &= x == kAllIn ? kAllIn : 0;
-    return all == kAllIn;
+    uint64_t all = kByteOnes;
+    for (const uint64_t x : w) all &= x == kByteOnes ? kByteOnes : 0;
+    return all == kByteOnes;
   };
   convert_outside_box(0, count, block_in, convert);
 }
@@ -457,11 +463,21 @@ bool ComponentLabeler::encode_row(int y, int x0, int x1) {
       x += 8;
       continue;
     }
-    while (c[x] == 0) ++x;
+    x += first_set_byte(word);
     if (x >= w) break;
     const uint8_t cls = c[x];
     const int run_x0 = x;
-    while (c[x] == cls) ++x;  // stops at the zero padding at the latest
+    // Eight samples at a time: the run stops at the zero padding at the
+    // latest, so a word wholly of the run ends at or before it.
+    const uint64_t run_word = kByteOnes * cls;
+    for (;;) {
+      std::memcpy(&word, c + x, sizeof word);
+      if (const uint64_t other = word ^ run_word; other != 0) {
+        x += first_set_byte(other);
+        break;
+      }
+      x += 8;
+    }
     const int run_x1 = x - 1;
     const int in_row = run_count_ - row_begin;
     if (cls == kDark) {
