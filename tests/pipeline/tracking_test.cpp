@@ -245,6 +245,40 @@ TEST(PlanTracking, WindowsHoldEveryWholeMarkerAndGrowWithThePredictionsErrors) {
             FullSweepReason::kUncertain);
 }
 
+// No margin until the filter has settled: three predictions skipped, three
+// more seen. Then the last prediction's error sizes it: a turn's transient
+// (20 mm, 0.6 degrees: no edge-tracked plan holds) is forgotten by the first
+// frame whose prediction was good again, and a new transient is heeded at
+// once.
+TEST(PlanTracking, TheLastPredictionsErrorSizesTheMarginOnceTheFilterHasSettled) {
+  PipelineConfig config;
+  config.detector.track_edges = true;
+  const ViewGeometry view(config);
+  MotionState s;
+  s.x[0] = 2.1, s.x[1] = 2.0, s.x[2] = 0.3;
+  TrackingPlan plan;
+  auto plan_with = [&](const PredictionErrors& errors) {
+    return plan_tracking(view, config.detector, config.positioning.mode, s, errors, &plan);
+  };
+  PredictionErrors errors;
+  for (int k = 0; k < 5; ++k) {
+    errors.add(0.0002, 0.0002);
+    EXPECT_EQ(plan_with(errors), FullSweepReason::kNoFix) << k + 1 << " predictions seen";
+  }
+  errors.add(0.0002, 0.0002);
+  ASSERT_EQ(plan_with(errors), FullSweepReason::kNone);
+  const double settled_margin_px = plan.margin_px;
+  errors.add(0.02, 0.01);
+  EXPECT_EQ(plan_with(errors), FullSweepReason::kUncertain) << "a transient is heeded at once";
+  EXPECT_GT(plan.margin_px, settled_margin_px + 10.0);
+  errors.add(0.0002, 0.0002);
+  EXPECT_EQ(plan_with(errors), FullSweepReason::kNone) << "and forgotten once predictions are good";
+  EXPECT_DOUBLE_EQ(plan.margin_px, settled_margin_px);
+  errors.reset();
+  errors.add(0.0002, 0.0002);
+  EXPECT_EQ(plan_with(errors), FullSweepReason::kNoFix) << "a lost fix settles again";
+}
+
 // Under a rolling shutter each predicted marker's frame is computed where
 // its own centre row is exposed, so an edge-tracked plan allows only for the
 // motion within a marker's rows, while windows allow for half the frame's
