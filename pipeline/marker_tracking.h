@@ -67,13 +67,13 @@ struct TrackingPlan {
 // the transient for seconds. One frame, not three: a turn's start rings
 // the filter for four or five frames, each error a third to a half of the
 // one before, so the last error bounds the next within the margin's
-// factor (track_margin_errors), and each frame remembered longer swept the
-// patrol path whole once more at every turn (whole sweeps 11.7 % of its
-// frames with three, 8.0 % with one; a missed marker costs a second sweep,
-// never a pose). The first predictions after the filter starts are left
-// out: its velocity starts at zero, so they err by a frame's motion (27 mm
-// at 0.8 m/s); and none sizes a margin until kSettling more were seen, over
-// which its velocity settles.
+// factor (track_margin_errors). Each frame remembered longer swept the
+// patrol path whole once more at every turn (uncertain whole sweeps
+// 11.7 % of its frames with three, 8.0 % with one); a missed marker costs
+// a second sweep, never a pose. The first predictions after the filter
+// starts are left out: its velocity starts at zero, so they err by a
+// frame's motion (27 mm at 0.8 m/s); and none sizes a margin until
+// kSettling more were seen, over which its velocity settles.
 class PredictionErrors {
  public:
   void add(double position_m, double yaw_rad);
