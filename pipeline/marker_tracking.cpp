@@ -31,17 +31,8 @@ const char* to_string(FullSweepReason reason) {
 
 void PredictionErrors::add(double position_m, double yaw_rad) {
   if (++samples_ <= kSkipped) return;
-  const int slot = (samples_ - kSkipped - 1) % kRemembered;
-  position_m_[slot] = std::abs(position_m);
-  yaw_rad_[slot] = std::abs(yaw_rad);
-}
-
-double PredictionErrors::max_position_m() const {
-  return *std::max_element(position_m_.begin(), position_m_.end());
-}
-
-double PredictionErrors::max_yaw_rad() const {
-  return *std::max_element(yaw_rad_.begin(), yaw_rad_.end());
+  position_m_ = std::abs(position_m);
+  yaw_rad_ = std::abs(yaw_rad);
 }
 
 namespace {
@@ -91,8 +82,8 @@ FullSweepReason plan_tracking(const ViewGeometry& view, const DetectorParams& pa
   // error), the recent predictions' largest errors in position and, at the
   // frame's corners, in yaw, and how far the view moves during the readout
   // (the prediction is the centre row's).
-  const double error_m = errors.max_position_m();
-  const double error_rad = errors.max_yaw_rad();
+  const double error_m = errors.position_m();
+  const double error_rad = errors.yaw_rad();
   const double half_diagonal_px = 0.5 * std::hypot(k.width, k.height);
   // The view's speed, pixels a second: translation, and the yaw's rotation
   // at the frame's corners; how far it moves during half the readout.

@@ -12,7 +12,6 @@
 // covariance covered the whole frame. A manoeuvre beyond the margin loses
 // or cuts a marker, and the frame is swept again whole: it costs time, never
 // a pose.
-#include <algorithm>
 #include <array>
 #include <cmath>
 #include <span>
@@ -60,17 +59,17 @@ struct TrackingPlan {
   }
 };
 
-// The largest one-frame-ahead prediction errors of the last kRemembered
-// frames. The largest, not an average: after a sudden stop or a robot set
-// down elsewhere the filter's predictions err by 100-250 mm for a few
-// frames, then by tenths of a millimetre again, and an average remembered
-// the transient for seconds. One frame, not three: a turn's start rings
-// the filter for four or five frames, each error a third to a half of the
-// one before, so the last error bounds the next within the margin's
-// factor (track_margin_errors). Each frame remembered longer swept the
-// patrol path whole once more at every turn (uncertain whole sweeps
-// 11.7 % of its frames with three, 8.0 % with one); a missed marker costs
-// a second sweep, never a pose. The first predictions after the filter
+// The last one-frame-ahead prediction's errors. The last, not an average:
+// after a sudden stop or a robot set down elsewhere the filter's
+// predictions err by 100-250 mm for a few frames, then by tenths of a
+// millimetre again, and an average remembered the transient for seconds.
+// Nor the largest of the last three: a turn's start rings the filter for
+// four or five frames, each error a third to a half of the one before, so
+// the last error bounds the next within the margin's factor
+// (track_margin_errors), and each older error remembered swept the patrol
+// path whole once more at every turn (uncertain whole sweeps 11.7 % of
+// its frames with three, 8.0 % with the last); a missed marker costs a
+// second sweep, never a pose. The first predictions after the filter
 // starts are left out: its velocity starts at zero, so they err by a
 // frame's motion (27 mm at 0.8 m/s); and none sizes a margin until
 // kSettling more were seen, over which its velocity settles.
@@ -79,15 +78,14 @@ class PredictionErrors {
   void add(double position_m, double yaw_rad);
   void reset() { *this = PredictionErrors{}; }
   // Enough predictions seen to size windows by.
-  bool known() const { return samples_ >= kSkipped + std::max(kSettling, kRemembered); }
-  double max_position_m() const;
-  double max_yaw_rad() const;
+  bool known() const { return samples_ >= kSkipped + kSettling; }
+  double position_m() const { return position_m_; }
+  double yaw_rad() const { return yaw_rad_; }
 
  private:
   static constexpr int kSkipped = 3;
   static constexpr int kSettling = 3;
-  static constexpr int kRemembered = 1;
-  std::array<double, kRemembered> position_m_{}, yaw_rad_{};
+  double position_m_ = 0.0, yaw_rad_ = 0.0;
   int samples_ = 0;
 };
 
