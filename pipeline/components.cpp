@@ -142,17 +142,19 @@ struct BoxTest {
   uint8_t y_lo, y_span, u_lo, u_span, v_lo, v_span;
 };
 
-// in[i] = 1 where the i-th of every `kPairs`-th YUYV pixel pair's first
-// pixel (own chroma) lies in `box`.
-template <int kPairs>
+// in[i] = 1 where the i-th of every `kPairs`-th YUYV pixel pair lies in
+// `box`: its first pixel (own chroma) or, kBothLumas, both its lumas and
+// its chroma.
+template <int kPairs, bool kBothLumas>
 CEILPOSE_VECTOR_CLONES void yuyv_in_box(const uint8_t* __restrict q, YuvBox box,
                                         uint8_t* __restrict in, int n) {
   const BoxTest t(box);
   for (int i = 0; i < n; ++i) {
     uint32_t w = 0;
     std::memcpy(&w, q + 4 * kPairs * i, sizeof w);
+    const uint8_t second_luma = kBothLumas ? t.y(static_cast<uint8_t>(w >> 16)) : 1;
     in[i] = static_cast<uint8_t>(t.y(static_cast<uint8_t>(w)) & t.u(static_cast<uint8_t>(w >> 8)) &
-                                 t.v(static_cast<uint8_t>(w >> 24)));
+                                 second_luma & t.v(static_cast<uint8_t>(w >> 24)));
   }
 }
 
@@ -170,19 +172,6 @@ CEILPOSE_VECTOR_CLONES void planar_in_box(const uint8_t* __restrict q, const uin
   }
 }
 
-// in[k] = 1 where YUYV pixel pair k (both lumas, its chroma) lies in
-// `box`, for the n pairs from q.
-CEILPOSE_VECTOR_CLONES void yuyv_pairs_in_box(const uint8_t* __restrict q, YuvBox box,
-                                              uint8_t* __restrict in, int n) {
-  const BoxTest t(box);
-  for (int k = 0; k < n; ++k) {
-    uint32_t w = 0;
-    std::memcpy(&w, q + 4 * k, sizeof w);
-    in[k] = static_cast<uint8_t>(t.y(static_cast<uint8_t>(w)) & t.u(static_cast<uint8_t>(w >> 8)) &
-                                 t.y(static_cast<uint8_t>(w >> 16)) &
-                                 t.v(static_cast<uint8_t>(w >> 24)));
-  }
-}
 // The same for 4:2:0 pairs: both lumas, and the chroma of both chroma rows
 // a pixel's chroma mixes (`near`, `far`; U and V kChromaStep bytes apart
 // along a row: NV12 2, I420 1).
@@ -421,7 +410,7 @@ void ComponentLabeler::classify_yuv_span_outside_box(const ImageView& frame, int
   uint8_t* in = in_box_.data();  // in[k - k0] for pair k
   const uint8_t* row = frame.row(y);
   if (frame.format == PixelFormat::kYuyv) {
-    yuyv_pairs_in_box(row + 4 * k0, box, in, k1 - k0 + 1);
+    yuyv_in_box<1, true>(row + 4 * k0, box, in, k1 - k0 + 1);
   } else {
     const int y_other = chroma_neighbour_row(y, frame.height);
     if (frame.format == PixelFormat::kNv12) {
@@ -795,7 +784,7 @@ void ComponentLabeler::classify_sampled_row(const ImageView& frame, int y, int s
       uint8_t* in = in_box_.data();
       const bool two = pairs == 2;
       if (frame.format == PixelFormat::kYuyv) {
-        (two ? yuyv_in_box<2> : yuyv_in_box<1>)(row, box, in, count);
+        (two ? yuyv_in_box<2, false> : yuyv_in_box<1, false>)(row, box, in, count);
       } else if (nv12) {
         (two ? planar_in_box<4, 4> : planar_in_box<2, 2>)(row, u, v, box, in, count);
       } else {
