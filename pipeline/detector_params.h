@@ -153,8 +153,8 @@ struct DetectorParams {
   int full_sweep_every = 30;
   // Window margin around a marker's predicted outline: this many pixels...
   float track_margin_px = 4.0f;
-  // ...plus this many times the largest error of the last three one-frame
-  // predictions (position, and yaw at the frame's corners).
+  // ...plus this many times the last one-frame prediction's error
+  // (position, and yaw at the frame's corners).
   float track_margin_errors = 3.0f;
   // Windows covering more than this share of the frame: sweep it whole.
   float track_max_area_share = 0.6f;
