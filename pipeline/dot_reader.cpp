@@ -52,20 +52,50 @@ const std::array<std::array<double, 256>, 3>& luma_shares() {
   return table;
 }
 
+// Adds weight w of both measures of a pixel of levels (r, g, b).
+void add_measures(uint8_t r, uint8_t g, uint8_t b, double w, Brightness* out) {
+  const auto& share = luma_shares();
+  (*out)[0] += w * std::max({r, g, b});
+  (*out)[1] += w * (share[0][r] + share[1][g] + share[2][b]);
+}
+
+// The same sum over a YUYV frame's pixels (x0, y0) to (x0 + 1, y0 + 1), in
+// the same order, each pixel's levels as pixel_rgb gives them: a row's two
+// pixels share one chroma pair when x0 is even, so its parts are computed
+// once: 336 → 298 instructions a sample (640×480 YUYV drive, ~650 samples a
+// frame).
+Brightness yuyv_brightness(const ImageView& frame, int x0, int y0, const double (&w)[4]) {
+  Brightness out{0.0, 0.0};
+  const int pair = x0 >> 1;
+  auto add = [&](int y_level, const YuvChromaParts& p, double weight) {
+    const int luma = yuv_luma_part(y_level);
+    add_measures(yuv_channel(luma, p.r), yuv_channel(luma, p.g), yuv_channel(luma, p.b), weight,
+                 &out);
+  };
+  for (int row = 0; row < 2; ++row) {
+    const uint8_t* q = frame.row(y0 + row) + 4 * pair;
+    const YuvChromaParts own = yuv_chroma_parts(q[1], q[3]);
+    if ((x0 & 1) == 0) {
+      add(q[0], own, w[2 * row]);
+      add(q[2], own, w[2 * row + 1]);
+    } else {
+      add(q[2], own, w[2 * row]);
+      add(q[4], yuv_chroma_parts(q[5], q[7]), w[2 * row + 1]);
+    }
+  }
+  return out;
+}
+
 Brightness brightness_at(const ImageView& frame, double u, double v) {
   const int x0 = floor_int(u), y0 = floor_int(v);
   if (x0 < 0 || y0 < 0 || x0 + 1 >= frame.width || y0 + 1 >= frame.height) return {-1.0, -1.0};
   const double fu = u - x0, fv = v - y0;
   const double w[4] = {(1 - fu) * (1 - fv), fu * (1 - fv), (1 - fu) * fv, fu * fv};
+  if (frame.format == PixelFormat::kYuyv) return yuyv_brightness(frame, x0, y0, w);
   Brightness out{0.0, 0.0};
   std::array<Rgb, 4> px;
   read_rgb_2x2(frame, x0, y0, &px);
-  const auto& share = luma_shares();
-  for (int k = 0; k < 4; ++k) {
-    const auto [r, g, b] = px[k];
-    out[0] += w[k] * std::max({r, g, b});
-    out[1] += w[k] * (share[0][r] + share[1][g] + share[2][b]);
-  }
+  for (int k = 0; k < 4; ++k) add_measures(px[k].r, px[k].g, px[k].b, w[k], &out);
   return out;
 }
 

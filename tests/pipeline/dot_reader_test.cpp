@@ -9,7 +9,9 @@
 #include <random>
 #include <vector>
 
+#include "core/pixel_read.h"
 #include "pipeline/rectangle_ends.h"
+#include "sim/camera_format.h"
 #include "tests/pipeline/detect_scene_support.h"
 
 namespace ceilpose {
@@ -69,6 +71,50 @@ TEST_F(DotReaderTest, EveryCodeReadsBackMsbNorthernmost) {
       EXPECT_EQ(ci.code, i) << i << "," << j;
       EXPECT_EQ(cj.code, j) << i << "," << j;
       EXPECT_GT(std::min(ci.margin, cj.margin), 0.2f);
+    }
+  }
+}
+
+// YUYV frames are read with each row's pair chroma computed once
+// (dot_reader.cpp): the ratios must be exactly those of the same pixels'
+// RGB, as read_rgb gives it, at every sub-pixel phase and rotation. Noise
+// makes every pair's chroma its own, so a pixel given its neighbour's
+// would show.
+TEST_F(DotReaderTest, YuyvReadsExactlyAsItsPixelsRgb) {
+  std::mt19937 rng(29);
+  std::uniform_int_distribution<int> noise(-25, 25);
+  for (int k = 0; k < 12; ++k) {
+    test::CraftedMarker m;
+    m.centre_u_px = 160.0 + 0.37 * k;
+    m.centre_v_px = 119.0 + 0.23 * k;
+    m.code_i = (5 * k + 3) % layout.codes();
+    m.code_j = (7 * k + 1) % layout.codes();
+    m.west_image_rad = 0.5 * k;
+    Image scene = test::render_markers(320, 240, std::span(&m, 1), layout);
+    for (int y = 0; y < scene.height(); ++y) {
+      for (int x = 0; x < 3 * scene.width(); ++x) {
+        uint8_t& level = scene.row(y)[x];
+        level = static_cast<uint8_t>(std::clamp(level + noise(rng), 0, 255));
+      }
+    }
+    const Image yuyv = sim::convert_rgb(scene, PixelFormat::kYuyv);
+    Image rgb(yuyv.width(), yuyv.height(), PixelFormat::kRgb24);
+    for (int y = 0; y < rgb.height(); ++y) {
+      for (int x = 0; x < rgb.width(); ++x) {
+        uint8_t* p = rgb.row(y) + 3 * x;
+        read_rgb(yuyv.view(), x, y, &p[0], &p[1], &p[2]);
+      }
+    }
+    const MarkerFrame f = frame_of(m, layout);
+    for (bool red : {true, false}) {
+      const CodeReading a =
+          read_code(yuyv.view(), f, red, layout, params, params.dot_threshold_ratio);
+      const CodeReading b =
+          read_code(rgb.view(), f, red, layout, params, params.dot_threshold_ratio);
+      ASSERT_TRUE(a.ok && b.ok) << k;
+      EXPECT_EQ(a.code, b.code) << k;
+      EXPECT_EQ(a.ratio, b.ratio) << k << (red ? " red" : " green");
+      EXPECT_EQ(a.margin, b.margin) << k;
     }
   }
 }
