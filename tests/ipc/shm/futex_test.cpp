@@ -41,7 +41,10 @@ TEST_F(ShmFutex, WaitNextWakesOnPublish) {
   EXPECT_EQ(p.seq, 1u);
   publisher.join();
   EXPECT_TRUE(waited) << "the reader never registered as blocked";
-  EXPECT_EQ(writer().wake_syscalls(), 1u) << "the publish woke the blocked reader";
+  // One, or none when the reader's wait returned spuriously just before the
+  // publish (seen under qemu): PublishWithBlockedWaiterMakesWakeSyscall
+  // holds the writer to the syscall.
+  EXPECT_LE(writer().wake_syscalls(), 1u) << "one publish, at most one wake";
   EXPECT_EQ(writer().waiting_readers(), 0u) << "the woken reader deregistered";
 }
 
@@ -75,16 +78,27 @@ TEST_F(ShmFutex, PublishWithoutWaitersMakesNoWakeSyscall) {
 
 TEST_F(ShmFutex, PublishWithBlockedWaiterMakesWakeSyscall) {
   ASSERT_NO_FATAL_FAILURE(start());
-  std::thread waiter([&] {
-    PoseRecord p;
-    EXPECT_EQ(reader().wait_next(0, 30'000, &p), WaitResult::kPose);
-  });
-  // Before the waiter registers, publishing makes no wake syscall.
-  EXPECT_EQ(writer().wake_syscalls(), 0u);
-  ASSERT_TRUE(until_a_reader_waits(writer()));
-  writer().publish(check_pose(1));
-  waiter.join();
-  EXPECT_EQ(writer().wake_syscalls(), 1u);
+  // A blocked reader's FUTEX_WAIT may return spuriously (EINTR; seen under
+  // qemu) and deregister just before the publish reads `waiters`; the reader
+  // then finds the pose itself and no wake is due. So a few rounds: a writer
+  // that never wakes makes no syscall in any of them.
+  constexpr uint64_t kRounds = 5;
+  uint64_t rounds = 0;
+  while (rounds < kRounds && writer().wake_syscalls() == 0) {
+    ++rounds;
+    std::thread waiter([&] {
+      PoseRecord p;
+      EXPECT_EQ(reader().wait_next(rounds - 1, 30'000, &p), WaitResult::kPose);
+      EXPECT_EQ(p.seq, rounds);
+    });
+    // Before the waiter registers, publishing makes no wake syscall.
+    EXPECT_EQ(writer().wake_syscalls(), 0u);
+    ASSERT_TRUE(until_a_reader_waits(writer()));
+    writer().publish(check_pose(rounds));
+    waiter.join();
+  }
+  EXPECT_EQ(writer().wake_syscalls(), 1u)
+      << "no publish woke a blocked reader in " << rounds << " rounds";
 }
 
 TEST_F(ShmFutex, ReaderProcessIsWokenByWriterProcess) {
