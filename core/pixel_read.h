@@ -43,11 +43,26 @@ inline void yuv_to_rgb(int y, int u, int v, uint8_t* r, uint8_t* g, uint8_t* b) 
 struct Yuv {
   uint8_t y, u, v;
 };
+// Each component alone as well (a camera's 4:2:2 pair has two lumas and one
+// chroma): rgb_to_yuv is the three together.
+inline uint8_t yuv_byte(double x) {
+  // std::lround's rounding (halves away from zero) without its library call:
+  // c - whole is exact for c in [0, 255].
+  const double c = std::clamp(x, 0.0, 255.0);
+  const int whole = static_cast<int>(c);
+  return static_cast<uint8_t>(whole + (c - whole >= 0.5 ? 1 : 0));
+}
+inline uint8_t rgb_to_y(double r, double g, double b) {
+  return yuv_byte(16.0 + (65.481 * r + 128.553 * g + 24.966 * b) / 255.0);
+}
+inline uint8_t rgb_to_u(double r, double g, double b) {
+  return yuv_byte(128.0 + (-37.797 * r - 74.203 * g + 112.0 * b) / 255.0);
+}
+inline uint8_t rgb_to_v(double r, double g, double b) {
+  return yuv_byte(128.0 + (112.0 * r - 93.786 * g - 18.214 * b) / 255.0);
+}
 inline Yuv rgb_to_yuv(double r, double g, double b) {
-  auto byte = [](double x) { return static_cast<uint8_t>(std::lround(std::clamp(x, 0.0, 255.0))); };
-  return {byte(16.0 + (65.481 * r + 128.553 * g + 24.966 * b) / 255.0),
-          byte(128.0 + (-37.797 * r - 74.203 * g + 112.0 * b) / 255.0),
-          byte(128.0 + (112.0 * r - 93.786 * g - 18.214 * b) / 255.0)};
+  return {rgb_to_y(r, g, b), rgb_to_u(r, g, b), rgb_to_v(r, g, b)};
 }
 
 // The darkest of the three channels yuv_to_rgb gives, without the three: a

@@ -9,19 +9,15 @@ namespace ceilpose::sim {
 
 namespace {
 
-// BT.601 limited range, V4L2's default quantisation (core/pixel_read.h).
-uint8_t luma(double r, double g, double b) { return rgb_to_yuv(r, g, b).y; }
-uint8_t chroma_u(double r, double g, double b) { return rgb_to_yuv(r, g, b).u; }
-uint8_t chroma_v(double r, double g, double b) { return rgb_to_yuv(r, g, b).v; }
-
-// 4:2:0: luma per pixel, U and V of each 2x2 block's mean colour, in the
+// 4:2:0 (BT.601 limited range, V4L2's default quantisation: core/pixel_read.h's
+// rgb_to_y/u/v): luma per pixel, U and V of each 2x2 block's mean colour, in the
 // layouts of core/image.h.
 void convert_yuv420(const Image& rgb, PixelFormat format, Image& out) {
   const int w = rgb.width(), h = rgb.height();
   const ImageView view = out.view();
   for (int y = 0; y < h; ++y) {
     const uint8_t* s = rgb.data() + static_cast<size_t>(y) * rgb.stride_bytes();
-    for (int x = 0; x < w; ++x) out.row(y)[x] = luma(s[3 * x], s[3 * x + 1], s[3 * x + 2]);
+    for (int x = 0; x < w; ++x) out.row(y)[x] = rgb_to_y(s[3 * x], s[3 * x + 1], s[3 * x + 2]);
   }
   for (int y = 0; y < h; y += 2) {
     for (int x = 0; x < w; x += 2) {
@@ -34,7 +30,7 @@ void convert_yuv420(const Image& rgb, PixelFormat format, Image& out) {
         }
       }
       for (double& c : m) c /= n;
-      const uint8_t u = chroma_u(m[0], m[1], m[2]), v = chroma_v(m[0], m[1], m[2]);
+      const uint8_t u = rgb_to_u(m[0], m[1], m[2]), v = rgb_to_v(m[0], m[1], m[2]);
       if (format == PixelFormat::kNv12) {
         auto* uv = const_cast<uint8_t*>(view.uv_row(y));
         uv[x] = u, uv[x + 1] = v;
@@ -60,39 +56,45 @@ void convert_rgb(const Image& rgb, PixelFormat format, Image* out_image) {
     out_image->resize(rgb.width(), rgb.height(), format);
   Image& out = *out_image;
   if (is_yuv420(format)) return convert_yuv420(rgb, format, out);
+  // One loop per format: a frame's 300 k pixels were a switch each, and a
+  // 4:2:2 pair's chroma is its mean colour's, converted once (the renderer
+  // must keep up with the synthetic camera's rate).
+  const int w = rgb.width();
   for (int y = 0; y < rgb.height(); ++y) {
     const uint8_t* s = rgb.data() + static_cast<size_t>(y) * rgb.stride_bytes();
     uint8_t* d = out.row(y);
-    for (int x = 0; x < rgb.width(); ++x) {
-      const int r = s[3 * x], g = s[3 * x + 1], b = s[3 * x + 2];
-      switch (format) {
-        case PixelFormat::kBgr24:
-          d[3 * x] = static_cast<uint8_t>(b);
-          d[3 * x + 1] = static_cast<uint8_t>(g);
-          d[3 * x + 2] = static_cast<uint8_t>(r);
-          break;
-        case PixelFormat::kGray8:
-          d[x] = static_cast<uint8_t>((77 * r + 150 * g + 29 * b + 128) >> 8);
-          break;
-        case PixelFormat::kYuyv: {
-          // U and V from this pixel and its pair.
-          d[2 * x] = luma(r, g, b);
-          if ((x & 1) == 0) {
-            const int x2 = std::min(x + 1, rgb.width() - 1);
-            const double r2 = 0.5 * (r + s[3 * x2]), g2 = 0.5 * (g + s[3 * x2 + 1]),
-                         b2 = 0.5 * (b + s[3 * x2 + 2]);
-            d[2 * x + 1] = chroma_u(r2, g2, b2);
-            if (x + 1 < rgb.width()) d[2 * x + 3] = chroma_v(r2, g2, b2);
+    switch (format) {
+      case PixelFormat::kBgr24:
+        for (int x = 0; x < w; ++x)
+          d[3 * x] = s[3 * x + 2], d[3 * x + 1] = s[3 * x + 1], d[3 * x + 2] = s[3 * x];
+        break;
+      case PixelFormat::kGray8:
+        for (int x = 0; x < w; ++x)
+          d[x] = static_cast<uint8_t>(
+              (77 * s[3 * x] + 150 * s[3 * x + 1] + 29 * s[3 * x + 2] + 128) >> 8);
+        break;
+      case PixelFormat::kYuyv:
+        for (int x = 0; x < w; x += 2) {
+          // U and V of the pair's mean colour (the last pixel of an odd
+          // width pairs with itself and has no V byte).
+          const int x2 = std::min(x + 1, w - 1);
+          const int r = s[3 * x], g = s[3 * x + 1], b = s[3 * x + 2];
+          const double r2 = 0.5 * (r + s[3 * x2]), g2 = 0.5 * (g + s[3 * x2 + 1]),
+                       b2 = 0.5 * (b + s[3 * x2 + 2]);
+          d[2 * x] = rgb_to_y(r, g, b);
+          d[2 * x + 1] = rgb_to_u(r2, g2, b2);
+          if (x + 1 < w) {
+            d[2 * x + 2] = rgb_to_y(s[3 * x2], s[3 * x2 + 1], s[3 * x2 + 2]);
+            d[2 * x + 3] = rgb_to_v(r2, g2, b2);
           }
-          break;
         }
-        case PixelFormat::kRgb24:
-        case PixelFormat::kMjpeg:
-        case PixelFormat::kNv12:
-        case PixelFormat::kYuv420:
-          d[3 * x] = s[3 * x], d[3 * x + 1] = s[3 * x + 1], d[3 * x + 2] = s[3 * x + 2];
-          break;
-      }
+        break;
+      case PixelFormat::kRgb24:
+      case PixelFormat::kMjpeg:
+      case PixelFormat::kNv12:
+      case PixelFormat::kYuv420:
+        std::copy(s, s + 3 * static_cast<size_t>(w), d);
+        break;
     }
   }
 }
