@@ -156,7 +156,9 @@ inline uint8_t CeilingScene::material_at(double x_m, double y_m, bool fixtures,
     if (inside) return static_cast<uint8_t>(kMaterialClutterBase + k);
   }
   if (fixtures) {
-    const double ti = std::floor(gx), tj = std::floor(gy);
+    // floor(g) from round(g) = floor(g + 0.5): one of round(g) and
+    // round(g) - 1, exactly (the hot path's two floors fewer).
+    const double ti = gx < ri ? ri - 1.0 : ri, tj = gy < rj ? rj - 1.0 : rj;
     if (std::abs(ti) < 1e12 && std::abs(tj) < 1e12) {
       const uint8_t kind = fixture_kind(static_cast<int64_t>(ti), static_cast<int64_t>(tj));
       if (kind != kNoFixture) {
