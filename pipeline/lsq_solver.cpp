@@ -171,6 +171,7 @@ LsqSolver::Fit LsqSolver::choose_tilt_model(const ViewGeometry& view,
                                             std::span<const MarkerFix> fixes, const Fit& seed,
                                             int* iterations, LsqResult* out) {
   Fit held = seed;
+  held.want_tilt_columns = params.lsq_estimate_tilt && seed.markers >= params.lsq_tilt_min_markers;
   optimise(view, params, fixes, &held, iterations);
   if (reweigh_edges(view, &held)) optimise(view, params, fixes, &held, iterations);
   if (!params.lsq_estimate_tilt || seed.markers < params.lsq_tilt_min_markers) {
@@ -234,19 +235,26 @@ LsqSolver::Fit LsqSolver::choose_tilt_model(const ViewGeometry& view,
 // from it: b^T A^-1 b of the normal equations with the tilt freed, at the
 // held optimum (where the held unknowns' part of b is ~0). For a problem as
 // near linear as this one it is what the free fit finds to a few percent,
-// at the cost of one pass over the points instead of 3-4.
+// without the 3-4 passes over the points of the free fit, and without one of
+// its own: the held fit's last pass gathered the tilt's rows
+// (Fit::tilt_columns); only the tilt's prior is added.
 double LsqSolver::free_tilt_gain_chi2(const ViewGeometry& view, const PositioningParams& params,
                                       const Fit& held) const {
   LsqModel model = held.model;
   model.active[kLsqTiltX] = model.active[kLsqTiltY] = true;
-  const std::span<const bool> use(held.use.data(), held.use.size());
-  LsqNormal a{};
-  LsqVector b{}, step{};
-  double wr2 = 0.0;
-  int n = 0;
-  const double cost =
-      accumulate(view, params, points(), use, held.state, model, true, &a, &b, &wr2, &n) +
-      prior_cost(view, params, model, held.state, &a, &b);
+  LsqNormal a = held.a;
+  LsqVector b = held.b, step{};
+  double cost = 0.0;
+  if (held.tilt_columns) {
+    cost = add_tilt_prior(view, params, held.state, 0.0, &a, &b);
+  } else {
+    // The held fit took no trial step: one pass of its own.
+    const std::span<const bool> use(held.use.data(), held.use.size());
+    double wr2 = 0.0;
+    int n = 0;
+    cost = accumulate(view, params, points(), use, held.state, model, true, &a, &b, &wr2, &n) +
+           prior_cost(view, params, model, held.state, &a, &b);
+  }
   if (!std::isfinite(cost) || !solve_spd<kLsqParams>(a, model.active, b, &step)) return INFINITY;
   double gain = 0.0;
   for (int i = 0; i < kLsqParams; ++i) gain += b[i] * step[i];
@@ -294,6 +302,11 @@ void LsqSolver::optimise(const ViewGeometry& view, const PositioningParams& para
   for (int pass = 0; pass <= params.lsq_max_rejections; ++pass) {
     fit->cost = INFINITY;
     double lambda = kLambdaStart;
+    // The columns a trial's pass fills: the model's, and the tilt's when
+    // asked.
+    LsqModel columns = fit->model;
+    if (fit->want_tilt_columns) columns.active[kLsqTiltX] = columns.active[kLsqTiltY] = true;
+    bool tilt_columns = false;
     double cost = accumulate(view, params, points(), use, st, fit->model, true, &a, &b, &wr2, &n) +
                   prior_cost(view, params, fit->model, st, &a, &b);
     if (!std::isfinite(cost)) return;
@@ -316,7 +329,7 @@ void LsqSolver::optimise(const ViewGeometry& view, const PositioningParams& para
       double twr2 = 0.0;
       int tn = 0;
       const double trial_cost =
-          accumulate(view, params, points(), use, trial, fit->model, true, &ta, &tb, &twr2, &tn) +
+          accumulate(view, params, points(), use, trial, columns, true, &ta, &tb, &twr2, &tn) +
           prior_cost(view, params, fit->model, trial, &ta, &tb);
       if (trial_cost <= cost) {
         st = trial;
@@ -325,6 +338,7 @@ void LsqSolver::optimise(const ViewGeometry& view, const PositioningParams& para
         b = tb;
         wr2 = twr2;
         n = tn;
+        tilt_columns = fit->want_tilt_columns;
         lambda = std::max(lambda * 0.1, 1e-9);
         double step_norm = 0.0;
         for (double v : step) step_norm = std::max(step_norm, std::abs(v));
@@ -336,6 +350,8 @@ void LsqSolver::optimise(const ViewGeometry& view, const PositioningParams& para
     }
     fit->cost = cost;
     fit->a = a;
+    fit->b = b;
+    fit->tilt_columns = tilt_columns;
     fit->wr2 = wr2;
     fit->residuals = n;
     if (fit->markers <= 1 || pass == params.lsq_max_rejections) break;

@@ -89,8 +89,16 @@ class LsqSolver {
     // residuals over their count. Valid while cost is finite and the fit is
     // not changed after optimise.
     LsqNormal a{};
+    LsqVector b{};
     double wr2 = 0.0;
     int residuals = 0;
+    // Asked for (want_) and held (tilt_columns): a and b hold the tilt's rows
+    // as well, for the tilt decision that follows a held fit
+    // (free_tilt_gain_chi2), which then needs no pass of its own over the
+    // points. The model's solve ignores them. Only the trials' passes
+    // gather them: a fit's first pass is almost never its last.
+    bool want_tilt_columns = false;
+    bool tilt_columns = false;
   };
 
   // The steps of solve(), in order (see lsq_solver.cpp).

@@ -267,6 +267,11 @@ double prior_cost(const ViewGeometry& view, const PositioningParams& params, con
     }
   }
   if (!model.tilt_free()) return motion;
+  return add_tilt_prior(view, params, st, motion, a, b);
+}
+
+double add_tilt_prior(const ViewGeometry& view, const PositioningParams& params, const LsqState& st,
+                      double cost, LsqNormal* a, LsqVector* b) {
   double ta = 0.0, tb = 0.0;
   camera_tilt_of(st.r_wc, &ta, &tb);
   const double w = 1.0 / params.lsq_tilt_prior_rad;
@@ -277,7 +282,7 @@ double prior_cost(const ViewGeometry& view, const PositioningParams& params, con
     (*b)[kLsqTiltX] -= w * ra;
     (*b)[kLsqTiltY] -= w * rb;
   }
-  return motion + ra * ra + rb * rb;
+  return cost + ra * ra + rb * rb;
 }
 
 LsqState held_motion(const LsqModel& model, const LsqState& st) {

@@ -125,6 +125,11 @@ double accumulate(const ViewGeometry& view, const PositioningParams& params,
 double prior_cost(const ViewGeometry& view, const PositioningParams& params, const LsqModel& model,
                   const LsqState& st, LsqNormal* a, LsqVector* b);
 
+// The tilt's prior alone (prior_cost's second part): `cost` plus its cost,
+// its terms added to the normal equations when `a` is given.
+double add_tilt_prior(const ViewGeometry& view, const PositioningParams& params, const LsqState& st,
+                      double cost, LsqNormal* a, LsqVector* b);
+
 // `st` with the motion it is held at when the fit does not estimate it.
 LsqState held_motion(const LsqModel& model, const LsqState& st);
 
