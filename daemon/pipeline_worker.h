@@ -81,6 +81,8 @@ class PipelineWorker {
   bool realtime() const { return realtime_.load(std::memory_order_acquire); }
   // Frames per refusal since start (any thread).
   const RefusalHistogram& refusals() const { return localizer_.refusals(); }
+  // Frames tracked and swept whole, by reason: read after stop().
+  const SweepCounts& sweeps() const { return localizer_.sweeps(); }
 
  private:
   struct Pending {

@@ -174,6 +174,16 @@ void BM_FrameToPose(benchmark::State& state, bool replay) {
     state.counters["work_p99_us"] =
         static_cast<double>(worker.latency().pipeline_to_published().summary().p99_us);
     state.counters["frames"] = static_cast<double>(worker.frames());
+    // Whole sweeps set the tail: their share, and the two main reasons'.
+    const SweepCounts& sweeps = worker.sweeps();
+    const double swept =
+        std::max<double>(1.0, static_cast<double>(sweeps.tracked() + sweeps.full()));
+    auto share = [&](FullSweepReason r) {
+      return static_cast<double>(sweeps.by_reason[static_cast<size_t>(r)]) / swept;
+    };
+    state.counters["whole_share"] = static_cast<double>(sweeps.full()) / swept;
+    state.counters["uncertain_share"] = share(FullSweepReason::kUncertain);
+    state.counters["scheduled_share"] = share(FullSweepReason::kScheduled);
     const double lost_first = static_cast<double>(half.skipped + half.drops);
     const double lost_all = static_cast<double>(end.skipped + end.drops);
     state.counters["skipped"] = lost_all;
