@@ -47,8 +47,10 @@ struct Yuv {
 // chroma): rgb_to_yuv is the three together.
 inline uint8_t yuv_byte(double x) {
   // std::lround's rounding (halves away from zero) without its library call:
-  // c - whole is exact for c in [0, 255].
-  const double c = std::clamp(x, 0.0, 255.0);
+  // c - whole is exact for c in [0, 255]. A NaN passes std::clamp unchanged
+  // and would make the cast undefined, so it is sent to 0 first.
+  if (!(x > 0.0)) return 0;
+  const double c = std::min(x, 255.0);
   const int whole = static_cast<int>(c);
   return static_cast<uint8_t>(whole + (c - whole >= 0.5 ? 1 : 0));
 }

@@ -7,6 +7,8 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cmath>
+#include <limits>
 #include <random>
 #include <string>
 
@@ -101,6 +103,20 @@ TEST(PixelRead, TwoByTwoEdgeLevelsAreTheChannelOrTheLumaInEveryFormat) {
   });
   EXPECT_EQ(yuv_channel(yuv_luma_part(16), 0), 0);
   EXPECT_EQ(yuv_channel(yuv_luma_part(235), 0), 255);
+}
+
+// yuv_byte rounds as std::lround does, clamps to a byte, and sends a NaN to 0
+// (a cast of NaN to int would be undefined).
+TEST(PixelRead, YuvByteRoundsHalvesUpClampsAndSendsNanToZero) {
+  for (double x = -3.0; x <= 258.0; x += 0.125) {
+    const long expected = std::clamp(std::lround(x), 0L, 255L);
+    EXPECT_EQ(yuv_byte(x), expected) << "x " << x;
+  }
+  EXPECT_EQ(yuv_byte(std::nextafter(0.5, 0.0)), 0);
+  EXPECT_EQ(yuv_byte(0.5), 1);
+  EXPECT_EQ(yuv_byte(std::numeric_limits<double>::quiet_NaN()), 0);
+  EXPECT_EQ(yuv_byte(std::numeric_limits<double>::infinity()), 255);
+  EXPECT_EQ(yuv_byte(-std::numeric_limits<double>::infinity()), 0);
 }
 
 }  // namespace
