@@ -21,12 +21,22 @@ struct MarkerPlacement {
   double sigma_yaw_rad = 0.0;
   int observations = 0;  // frames in which the survey decoded it (0: not known)
 
+  // yaw_rad's cosine and sine, for world_point over many points of one
+  // marker (a sine and a cosine each cost more than the point).
+  struct Rotation {
+    double cos = 1.0, sin = 0.0;
+  };
+  Rotation rotation() const { return {std::cos(yaw_rad), std::sin(yaw_rad)}; }
+
   // World (x, y) of the marker-frame point (e, n) (SPEC §2 frame, rotated by
-  // yaw_rad about the centre).
+  // yaw_rad about the centre); `r` is rotation().
+  void world_point(const Rotation& r, double e_m, double n_m, double* x_m_out,
+                   double* y_m_out) const {
+    *x_m_out = x_m + r.cos * e_m - r.sin * n_m;
+    *y_m_out = y_m + r.sin * e_m + r.cos * n_m;
+  }
   void world_point(double e_m, double n_m, double* x_m_out, double* y_m_out) const {
-    const double c = std::cos(yaw_rad), s = std::sin(yaw_rad);
-    *x_m_out = x_m + c * e_m - s * n_m;
-    *y_m_out = y_m + s * e_m + c * n_m;
+    world_point(rotation(), e_m, n_m, x_m_out, y_m_out);
   }
   bool operator==(const MarkerPlacement&) const = default;
 };

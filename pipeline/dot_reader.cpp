@@ -6,6 +6,7 @@
 #include <numbers>
 
 #include "core/int_rounding.h"
+#include "core/length_2d.h"
 #include "core/pixel_read.h"
 #include "pipeline/color_classifier.h"
 
@@ -148,7 +149,7 @@ MarkerRegion::MarkerRegion(const MarkerFrame& marker, double e0_m, double e1_m, 
                            double n1_m, int width, int height)
     : centre_u_px_(marker.centre_u_px), centre_v_px_(marker.centre_v_px), width_(width) {
   const double det = marker.east_u * marker.north_v - marker.east_v * marker.north_u;
-  const double px_per_m = std::hypot(marker.north_u, marker.north_v);
+  const double px_per_m = length_2d(marker.north_u, marker.north_v);
   if (!(std::abs(det) > 0.0) || !(px_per_m > 0.0) || !(e0_m <= e1_m) || !(n0_m <= n1_m)) return;
   // A bilinear read at the rectangle's rim touches the pixel beyond it.
   const double pad_m = 1.5 / px_per_m;
@@ -222,7 +223,7 @@ float dot_threshold_ratio(const DetectorParams& params, double blur_px, double r
   if (blur_px < 0.0 || red_dot_px <= 0.0) return params.dot_threshold_ratio;
   const double span = params.blur_shift_full - params.blur_shift_start;
   const double x =
-      std::hypot(blur_px, params.sampling_blur_px) / red_dot_px - params.blur_shift_start;
+      length_2d(blur_px, params.sampling_blur_px) / red_dot_px - params.blur_shift_start;
   const double f = span > 0.0 ? std::clamp(x / span, 0.0, 1.0) : (x >= 0.0 ? 1.0 : 0.0);
   return params.dot_threshold_ratio + static_cast<float>(f) * params.dot_threshold_blur_shift;
 }
@@ -251,7 +252,7 @@ CodeReading read_code(const ImageView& frame, const MarkerFrame& marker, bool re
   if (ref_count == 0) return out;
   const Brightness reference{ref_sum[0] / ref_count, ref_sum[1] / ref_count};
   if (reference[0] < 1.0 || reference[1] < 1.0) return out;
-  const double px_per_m = std::hypot(marker.north_u, marker.north_v);
+  const double px_per_m = length_2d(marker.north_u, marker.north_v);
   // One pixel, or a sixth of the dot's height in large images.
   const double step_m = std::max(px_per_m > 0.0 ? 1.0 / px_per_m : search_m,
                                  (red ? layout.red_dot_n_m : layout.green_dot_n_m) / 6.0);

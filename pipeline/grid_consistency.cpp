@@ -2,6 +2,8 @@
 
 #include <cmath>
 
+#include "core/length_2d.h"
+
 namespace ceilpose {
 namespace {
 
@@ -29,8 +31,7 @@ int grid_consistent_subset(const PositioningParams& params, double grid_m,
     for (int m = 0; m < n; ++m) {
       if (!agree(fixes[k], fixes[m], tolerance_m, params.heading_tolerance_rad)) continue;
       ++support;
-      spread +=
-          std::hypot(fixes[k].cam_x_m - fixes[m].cam_x_m, fixes[k].cam_y_m - fixes[m].cam_y_m);
+      spread += length_2d(fixes[k].cam_x_m - fixes[m].cam_x_m, fixes[k].cam_y_m - fixes[m].cam_y_m);
     }
     if (support > best_support || (support == best_support && spread < best_spread)) {
       best = k;

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "core/length_2d.h"
 #include "core/small_matrix.h"
 
 namespace ceilpose {
@@ -100,6 +101,7 @@ int LsqSolver::gather_points(const ViewGeometry& view, const PositioningParams& 
     if (!use[f]) continue;
     const MarkerFix& fix = fixes[f];
     const MarkerObservation& m = markers[fix.index];
+    const MarkerPlacement::Rotation rotation = fix.placement->rotation();
     auto add = [&](double e_m, double n_m, double u_px, double v_px, double normal_u = 0.0,
                    double normal_v = 0.0) {
       if (point_count_ >= static_cast<int>(points_.size())) return;
@@ -116,7 +118,7 @@ int LsqSolver::gather_points(const ViewGeometry& view, const PositioningParams& 
         double x1 = 0.0, y1 = 0.0;
         undistort_pixel(k, u_px + normal_u, v_px + normal_v, &x1, &y1);
         const double nx = k.fx * (x1 - p.x_n), ny = k.fy * (y1 - p.y_n);
-        const double len = std::hypot(nx, ny);
+        const double len = length_2d(nx, ny);
         if (!(len > 0.0)) {
           --point_count_;
           return;
@@ -127,7 +129,7 @@ int LsqSolver::gather_points(const ViewGeometry& view, const PositioningParams& 
       }
       p.tau_s = row_time_s(k, v_px);
       double x_m = 0.0, y_m = 0.0;
-      fix.placement->world_point(e_m, n_m, &x_m, &y_m);
+      fix.placement->world_point(rotation, e_m, n_m, &x_m, &y_m);
       p.world = {x_m, y_m, layout.height_m};
       p.fix = f;
     };

@@ -4,6 +4,8 @@
 #include <cmath>
 #include <numbers>
 
+#include "core/length_2d.h"
+
 // Two rectangles of one marker share a long edge, so (SPEC §2): their long
 // axes are parallel, the vector between their centres is perpendicular to
 // them and as long as one rectangle is wide (5 in, i.e. 5/12 of the long
@@ -44,7 +46,7 @@ int MarkerPairer::pair(std::span<const RectangleCandidate> rects, const CeilingL
       const RectangleCandidate& green = rects[j];
       if (green.cls != PixelClass::kGreen) continue;
       const double du = green.cx - red.cx, dv = green.cy - red.cy;
-      const double dist = std::hypot(du, dv);
+      const double dist = length_2d(du, dv);
       const double expected = 0.5 * (red.long_px + green.long_px) * width_per_length;
       if (dist <= 0.0 || expected <= 0.0) continue;
       const double dist_err = std::abs(dist / expected - 1.0);

@@ -4,6 +4,7 @@
 #include <cmath>
 
 #include "core/camera_model.h"
+#include "core/length_2d.h"
 #include "pipeline/camera_motion.h"
 #include "pipeline/rectangle_ends.h"
 
@@ -49,9 +50,10 @@ bool marker_frame_at(const ViewGeometry& view, const MarkerPlacement& p, const M
   const CameraPose camera = camera_pose_from_robot(robot, view.mount());
   const double points_m[3][2] = {{0.0, 0.0}, {kStep_m, 0.0}, {0.0, kStep_m}};
   double u[3], v[3];
+  const MarkerPlacement::Rotation rotation = p.rotation();
   for (int q = 0; q < 3; ++q) {
     double x_m = 0.0, y_m = 0.0;
-    p.world_point(points_m[q][0], points_m[q][1], &x_m, &y_m);
+    p.world_point(rotation, points_m[q][0], points_m[q][1], &x_m, &y_m);
     if (!project_world_point(view.intrinsics(), camera, {x_m, y_m, view.layout().height_m}, &u[q],
                              &v[q]))
       return false;
@@ -122,10 +124,11 @@ FullSweepReason plan_tracking(const ViewGeometry& view, const DetectorParams& pa
       constexpr double kCornerE[4] = {-1.0, 1.0, 1.0, -1.0}, kCornerN[4] = {-1.0, -1.0, 1.0, 1.0};
       std::array<double, 4> cu{}, cv{};
       bool projected = true;
+      const MarkerPlacement::Rotation rotation = p->rotation();
       for (int c = 0; c < 4; ++c) {
         double x_m = 0.0, y_m = 0.0;
-        p->world_point(kCornerE[c] * layout.rect_width_m, kCornerN[c] * 0.5 * layout.rect_height_m,
-                       &x_m, &y_m);
+        p->world_point(rotation, kCornerE[c] * layout.rect_width_m,
+                       kCornerN[c] * 0.5 * layout.rect_height_m, &x_m, &y_m);
         projected = projected &&
                     project_world_point(k, camera, {x_m, y_m, layout.height_m}, &cu[c], &cv[c]);
       }
@@ -143,11 +146,11 @@ FullSweepReason plan_tracking(const ViewGeometry& view, const DetectorParams& pa
         for (int c = 0; c < 4 && projected; ++c) {
           const int d = (c + 1) % 4;
           double x_m = 0.0, y_m = 0.0, u = 0.0, v = 0.0;
-          p->world_point(0.5 * (kCornerE[c] + kCornerE[d]) * layout.rect_width_m,
+          p->world_point(rotation, 0.5 * (kCornerE[c] + kCornerE[d]) * layout.rect_width_m,
                          0.25 * (kCornerN[c] + kCornerN[d]) * layout.rect_height_m, &x_m, &y_m);
           projected = project_world_point(k, camera, {x_m, y_m, layout.height_m}, &u, &v);
           bow_px =
-              std::max(bow_px, std::hypot(u - 0.5 * (cu[c] + cu[d]), v - 0.5 * (cv[c] + cv[d])));
+              std::max(bow_px, length_2d(u - 0.5 * (cu[c] + cu[d]), v - 0.5 * (cv[c] + cv[d])));
         }
         if (!projected || !std::isfinite(bow_px)) return FullSweepReason::kUncertain;
       }
@@ -170,7 +173,7 @@ FullSweepReason plan_tracking(const ViewGeometry& view, const DetectorParams& pa
       // The outline widened by the margin on every side: each corner moves
       // out along both of its sides' directions.
       const double eu = cu[1] - cu[0], ev = cv[1] - cv[0], nu = cu[3] - cu[0], nv = cv[3] - cv[0];
-      const double e_len = std::hypot(eu, ev), n_len = std::hypot(nu, nv);
+      const double e_len = length_2d(eu, ev), n_len = length_2d(nu, nv);
       if (e_len > 1.0 && n_len > 1.0) {
         win.quad = true;
         for (int c = 0; c < 4; ++c) {

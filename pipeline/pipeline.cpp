@@ -5,6 +5,7 @@
 #include <string>
 
 #include "core/clock.h"
+#include "core/length_2d.h"
 #include "core/pixel_read.h"
 #include "pipeline/dot_reader.h"
 #include "pipeline/rectangle_ends.h"
@@ -110,7 +111,7 @@ PairOutcome Pipeline::read_codes(const ImageView& frame, const MarkerFrame& m,
   const CeilingLayout& layout = config_.layout;
   // Blur first: it decides whether the dots can be read and where their
   // threshold lies.
-  const double red_dot_px = layout.red_dot_n_m * std::hypot(m.north_u, m.north_v);
+  const double red_dot_px = layout.red_dot_n_m * length_2d(m.north_u, m.north_v);
   const double blur_px = red_edges.spread_px;
   if (blur_px > config_.detector.max_blur_to_dot * red_dot_px) return PairOutcome::kBlurred;
   const float threshold = dot_threshold_ratio(config_.detector, blur_px, red_dot_px);
@@ -214,7 +215,7 @@ PairOutcome Pipeline::decode(const ImageView& frame, const MarkerPair& pair,
   }
   const CeilingLayout& layout = config_.layout;
   const MarkerFrame m = marker_frame(red, green, layout);
-  const double px_per_m = std::hypot(m.north_u, m.north_v);
+  const double px_per_m = length_2d(m.north_u, m.north_v);
   const RectangleEdges red_edges = measure_edges(frame, m, true, layout);
   CodeReading code_i, code_j;
   const PairOutcome read =
@@ -271,13 +272,13 @@ PairOutcome Pipeline::measure_at(const ImageView& frame, MarkerFrame m, MarkerOb
   // way the marker is refused rather than positioned with.
   double du = 0.0, dv = 0.0;
   if (!edge_shift_px(m, red_edges, green_edges, &du, &dv)) return PairOutcome::kInconsistent;
-  if (std::hypot(du, dv) > kRecentreEdges_px) {
+  if (length_2d(du, dv) > kRecentreEdges_px) {
     m.centre_u_px += du;
     m.centre_v_px += dv;
     red_edges = measure_edges(frame, m, true, layout, EdgeLevels::kLinearLight);
     green_edges = measure_edges(frame, m, false, layout, EdgeLevels::kLinearLight);
     if (!edge_shift_px(m, red_edges, green_edges, &du, &dv) ||
-        std::hypot(du, dv) > kRecentreEdges_px)
+        length_2d(du, dv) > kRecentreEdges_px)
       return PairOutcome::kInconsistent;
   }
   // The dots are then where the edges put them, to a pixel: their darkest
@@ -335,7 +336,7 @@ PairOutcome Pipeline::measure_found(const ImageView& frame, const MarkerPair& pa
   const MarkerFrame m = marker_frame(red, green, layout);
   const PairOutcome outcome = measure_at(frame, m, out);
   if (outcome != PairOutcome::kDecoded) return outcome;
-  const double px_per_m = std::hypot(m.north_u, m.north_v);
+  const double px_per_m = length_2d(m.north_u, m.north_v);
   if (!dark_area_consistent(red, out->code_i, true, layout, px_per_m) ||
       !dark_area_consistent(green, out->code_j, false, layout, px_per_m))
     return PairOutcome::kInconsistent;

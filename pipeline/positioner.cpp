@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "core/length_2d.h"
 #include "pipeline/barycentric.h"
 #include "pipeline/camera_motion.h"
 #include "pipeline/grid_consistency.h"
@@ -48,10 +49,10 @@ double Positioner::depth_scale(int fix_count) {
     if (!inlier_[a]) continue;
     for (int b = a + 1; b < fix_count; ++b) {
       if (!inlier_[b]) continue;
-      const double world_m = std::hypot(fixes_[a].world_x_m - fixes_[b].world_x_m,
-                                        fixes_[a].world_y_m - fixes_[b].world_y_m);
-      const double image_n = std::hypot(fixes_[a].centre_x_n - fixes_[b].centre_x_n,
-                                        fixes_[a].centre_y_n - fixes_[b].centre_y_n);
+      const double world_m = length_2d(fixes_[a].world_x_m - fixes_[b].world_x_m,
+                                       fixes_[a].world_y_m - fixes_[b].world_y_m);
+      const double image_n = length_2d(fixes_[a].centre_x_n - fixes_[b].centre_x_n,
+                                       fixes_[a].centre_y_n - fixes_[b].centre_y_n);
       if (world_m <= 0.0 || image_n <= 0.0) continue;
       pair_scales_[pairs++] = world_m / image_n / view_.depth_m();
     }

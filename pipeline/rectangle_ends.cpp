@@ -5,6 +5,7 @@
 #include <type_traits>
 
 #include "core/int_rounding.h"
+#include "core/length_2d.h"
 #include "core/pixel_read.h"
 
 namespace ceilpose {
@@ -377,7 +378,7 @@ EdgeCrossing cross_edge(const ImageView& frame, const MarkerFrame& marker, doubl
   out.v_px = v_sum / found;
   const double nu = de * marker.east_u + dn * marker.north_u;
   const double nv = de * marker.east_v + dn * marker.north_v;
-  const double len = std::hypot(nu, nv);
+  const double len = length_2d(nu, nv);
   out.normal_u = nu / len;
   out.normal_v = nv / len;
   return out;
@@ -409,7 +410,7 @@ RectangleEdges measure_edges(const ImageView& frame, const MarkerFrame& marker, 
   const EdgeChannel channel = frame.chroma_halved ? EdgeChannel::kLuma
                               : red               ? EdgeChannel::kGreen
                                                   : EdgeChannel::kRed;
-  const double px_per_m = std::hypot(marker.north_u, marker.north_v);
+  const double px_per_m = length_2d(marker.north_u, marker.north_v);
   if (!(px_per_m > 0.0)) return out;
   const int samples =
       std::clamp(static_cast<int>(2.0 * kEdgeProfileHalf_m * px_per_m) + 1, 5, kMaxSamples);
