@@ -5,6 +5,7 @@
 
 #include "core/clock.h"
 #include "core/finite.h"
+#include "pipeline/camera_motion.h"
 
 namespace ceilpose {
 namespace {
@@ -55,6 +56,8 @@ void Localizer::reconfigure(const PipelineConfig& config, bool reset_filter) {
   if (reset_filter) {
     filter_ = TemporalFilter(config.filter);
     prediction_errors_.reset();
+    measured_count_ = 0;
+    extrapolation_errors_.reset();
     had_fix_ = false;
   }
 }
@@ -68,6 +71,7 @@ const Localization& Localizer::localize(const ImageView& image, const FrameInfo&
   // readout's motion and for the tracking windows.
   has_prediction_ = filter && predict_motion(filter_.motion(), frame.timestamp_ns, &predicted_) ==
                                   PredictOutcome::kOk;
+  extrapolate(frame.timestamp_ns);
   const CameraMotion motion = readout_motion();
   FullSweepReason sweep = plan_sweep();
   out_.swept_px = 0;
@@ -150,11 +154,15 @@ const Localization& Localizer::localize(const ImageView& image, const FrameInfo&
   const bool last_measured_before = last_measured_;
   last_measured_ = out_.measured.valid;
   remember_decoded();
+  auto add_error = [&](const MotionState& s, PredictionErrors* errors) {
+    errors->add(std::hypot(out_.measured.pose.x_m - s.x[0], out_.measured.pose.y_m - s.x[1]),
+                wrap_angle_rad(out_.measured.pose.yaw_rad - s.x[2]));
+  };
   if (has_prediction_ && last_measured_before && out_.measured.valid) {
-    prediction_errors_.add(std::hypot(out_.measured.pose.x_m - predicted_.x[0],
-                                      out_.measured.pose.y_m - predicted_.x[1]),
-                           wrap_angle_rad(out_.measured.pose.yaw_rad - predicted_.x[2]));
+    add_error(predicted_, &prediction_errors_);
   }
+  if (has_extrapolation_ && out_.measured.valid) add_error(extrapolated_, &extrapolation_errors_);
+  remember_measured(frame.timestamp_ns);
   out_.localize_ns = monotonic_ns() - start_ns;
   return out_;
 }
@@ -181,6 +189,49 @@ CameraMotion Localizer::readout_motion() const {
   return m;
 }
 
+// The constant twist of the last two measurements (their chord's velocity
+// turned to the tangent at the newer one) carried to t_ns.
+void Localizer::extrapolate(int64_t t_ns) {
+  has_extrapolation_ = false;
+  if (measured_count_ < 2 || !last_measured_) return;
+  const Measured& a = measured_[0];
+  const Measured& b = measured_[1];
+  const double dt1_s = 1e-9 * static_cast<double>(b.t_ns - a.t_ns);
+  const double dt_s = 1e-9 * static_cast<double>(t_ns - b.t_ns);
+  if (!(dt1_s > 0.0) || !(dt_s > 0.0)) return;
+  const double w = wrap_angle_rad(b.yaw_rad - a.yaw_rad) / dt1_s;
+  // A chord of a constant twist runs along the tangent at its middle.
+  const double turn = 0.5 * w * dt1_s, c = std::cos(turn), s = std::sin(turn);
+  const double cx = (b.x_m - a.x_m) / dt1_s, cy = (b.y_m - a.y_m) / dt1_s;
+  const double vx = c * cx - s * cy, vy = s * cx + c * cy;
+  double dx_m = 0.0, dy_m = 0.0;
+  arc_displacement(vx, vy, w, dt_s, &dx_m, &dy_m);
+  extrapolated_ = predicted_;
+  extrapolated_.x[0] = b.x_m + dx_m;
+  extrapolated_.x[1] = b.y_m + dy_m;
+  extrapolated_.x[2] = wrap_angle_rad(b.yaw_rad + w * dt_s);
+  const double c2 = std::cos(w * dt_s), s2 = std::sin(w * dt_s);
+  extrapolated_.x[3] = c2 * vx - s2 * vy;
+  extrapolated_.x[4] = s2 * vx + c2 * vy;
+  extrapolated_.x[5] = w;
+  for (int k = 6; k < kMotionStates; ++k) extrapolated_.x[k] = 0.0;
+  has_extrapolation_ = std::isfinite(extrapolated_.x[0] + extrapolated_.x[1] + extrapolated_.x[2] +
+                                     extrapolated_.x[3] + extrapolated_.x[4] + w);
+}
+
+void Localizer::remember_measured(int64_t t_ns) {
+  if (!out_.measured.valid) {
+    measured_count_ = 0;
+    extrapolation_errors_.reset();
+    return;
+  }
+  const Measured m{t_ns, out_.measured.pose.x_m, out_.measured.pose.y_m,
+                   out_.measured.pose.yaw_rad};
+  if (measured_count_ == 2) measured_[0] = measured_[1];
+  measured_[std::min(measured_count_, 1)] = m;
+  measured_count_ = std::min(measured_count_ + 1, 2);
+}
+
 FullSweepReason Localizer::plan_sweep() {
   const PipelineConfig& c = pipeline_.config();
   // Windows only from a prediction that the last frame's measurement
@@ -190,6 +241,14 @@ FullSweepReason Localizer::plan_sweep() {
   if (!c.detector.tracking || !c.filter.enabled) return FullSweepReason::kOff;
   if (!fix) return FullSweepReason::kNoFix;
   if (frames_since_full_ + 1 >= c.detector.full_sweep_every) return FullSweepReason::kScheduled;
+  const bool extrapolation_better = has_extrapolation_ && extrapolation_errors_.known() &&
+                                    prediction_errors_.known() &&
+                                    prediction_error_px(view_, extrapolation_errors_) <
+                                        prediction_error_px(view_, prediction_errors_);
+  if (extrapolation_better) {
+    return plan_tracking(view_, c.detector, c.positioning.mode, extrapolated_,
+                         extrapolation_errors_, &plan_);
+  }
   return plan_tracking(view_, c.detector, c.positioning.mode, predicted_, prediction_errors_,
                        &plan_);
 }

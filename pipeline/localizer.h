@@ -65,6 +65,23 @@ class Localizer {
   MotionState predicted_;        // the filter's state carried to this frame's time
   bool has_prediction_ = false;  // ... when there was one
   PredictionErrors prediction_errors_;
+  // A second prediction for the tracking plan alone: the last two
+  // consecutive measurements' motion carried on as a constant twist. After
+  // a sudden turn it is right again a frame after the turn's start, while
+  // the filter (constant acceleration) rings for four or five frames; on a
+  // steady path the filter is the better. The plan takes whichever erred
+  // less last frame.
+  struct Measured {
+    int64_t t_ns = 0;
+    double x_m = 0.0, y_m = 0.0, yaw_rad = 0.0;
+  };
+  std::array<Measured, 2> measured_{};  // the last two, newest last
+  int measured_count_ = 0;              // consecutive measured frames held, 0-2
+  MotionState extrapolated_;
+  bool has_extrapolation_ = false;
+  PredictionErrors extrapolation_errors_;
+  void extrapolate(int64_t t_ns);
+  void remember_measured(int64_t t_ns);
   // Map indices (j * codes + i) of the markers the last frame decoded:
   // decoded_last_[index] != 0, listed in last_decoded_.
   std::vector<uint8_t> decoded_last_;

@@ -72,6 +72,13 @@ bool marker_frame_at(const ViewGeometry& view, const MarkerPlacement& p, const M
 
 }  // namespace
 
+double prediction_error_px(const ViewGeometry& view, const PredictionErrors& errors) {
+  const CameraIntrinsics& k = view.intrinsics();
+  const double px_per_m = std::max(k.fx, k.fy) / view.depth_m();
+  const double half_diagonal_px = 0.5 * std::hypot(k.width, k.height);
+  return errors.position_m() * px_per_m + errors.yaw_rad() * half_diagonal_px;
+}
+
 FullSweepReason plan_tracking(const ViewGeometry& view, const DetectorParams& params,
                               PositioningMode mode, const MotionState& s,
                               const PredictionErrors& errors, TrackingPlan* plan) {
@@ -84,8 +91,6 @@ FullSweepReason plan_tracking(const ViewGeometry& view, const DetectorParams& pa
   // error), the recent predictions' largest errors in position and, at the
   // frame's corners, in yaw, and how far the view moves during the readout
   // (the prediction is the centre row's).
-  const double error_m = errors.position_m();
-  const double error_rad = errors.yaw_rad();
   const double half_diagonal_px = 0.5 * std::hypot(k.width, k.height);
   // The view's speed, pixels a second: translation, and the yaw's rotation
   // at the frame's corners; how far it moves during half the readout.
@@ -93,8 +98,7 @@ FullSweepReason plan_tracking(const ViewGeometry& view, const DetectorParams& pa
   const double view_px_per_s =
       std::hypot(s.x[3], s.x[4]) * px_per_m + std::abs(s.x[5]) * half_diagonal_px;
   const double readout_px = view_px_per_s * 0.5 * readout_s;
-  const double predictions_px =
-      params.track_margin_errors * (error_m * px_per_m + error_rad * half_diagonal_px);
+  const double predictions_px = params.track_margin_errors * prediction_error_px(view, errors);
   const double margin_px = params.track_margin_px + predictions_px + readout_px;
   plan->margin_px = margin_px;
   plan->edges = params.track_edges && !positions_from_centroids(mode);

@@ -101,8 +101,15 @@ enum class FullSweepReason : uint8_t {
 };
 const char* to_string(FullSweepReason reason);
 
+// How far off, pixels, a marker at the frame's corner may be when the next
+// prediction errs as the last (`errors`) did: the position error times the
+// ceiling's pixels a metre, plus the yaw error times the half diagonal.
+// plan_tracking's margins grow with it; the localizer plans from whichever
+// prediction makes it smaller.
+double prediction_error_px(const ViewGeometry& view, const PredictionErrors& errors);
+
 // Plans the windows (or, edge-tracked, the markers) for positioning `mode`
-// and the robot state `s` (the filter's, predicted to the frame's time; the
+// and the robot state `s` (predicted to the frame's time; the
 // camera's readout_ms widens them) whose predictions have erred by
 // `errors`. Returns kNone and fills `plan`, or the reason to sweep the whole
 // frame.

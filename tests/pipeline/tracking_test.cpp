@@ -452,7 +452,7 @@ XPose path_pose(int k) {
 }
 
 struct Compared {
-  int frames = 0, tracked = 0, track_failed = 0;
+  int frames = 0, tracked = 0, track_failed = 0, uncertain = 0;
   int halved = 0;  // whole sweeps that found the markers at half resolution
   int valid_full = 0, valid_tracked = 0, valid_only_tracked = 0;
   double max_difference_mm = 0.0;
@@ -472,7 +472,7 @@ double p99(const std::vector<double>& sorted) {
 }
 
 Compared compare(int frames, PixelFormat format, const XCamera& camera = {},
-                 bool track_edges = false) {
+                 bool track_edges = false, XPose (*path)(int) = path_pose) {
   PipelineConfig config = with_mode(config_for(camera), PositioningMode::kAuto, true);
   PipelineConfig whole = config;
   whole.detector.tracking = false;
@@ -482,7 +482,7 @@ Compared compare(int frames, PixelFormat format, const XCamera& camera = {},
   Localizer tracking(config), full(whole);
   Compared c;
   for (int k = 0; k < frames; ++k) {
-    const XPose truth = path_pose(k);
+    const XPose truth = path(k);
     XRenderOptions options;
     options.noise_sigma = 2.0;
     options.seed = static_cast<uint64_t>(k) + 1;
@@ -519,6 +519,8 @@ Compared compare(int frames, PixelFormat format, const XCamera& camera = {},
                                                          full_pose.pose.y_m - b.measured.pose.y_m));
     }
   }
+  c.uncertain = static_cast<int>(
+      tracking.sweeps().by_reason[static_cast<size_t>(FullSweepReason::kUncertain)]);
   EXPECT_EQ(tracking.sweeps().tracked(), static_cast<uint64_t>(c.tracked));
   EXPECT_EQ(tracking.sweeps().full(), static_cast<uint64_t>(c.frames - c.tracked));
   EXPECT_EQ(tracking.sweeps().halved, static_cast<uint64_t>(c.halved));
@@ -594,6 +596,49 @@ TEST(TrackedLocalizer, AnArcAPauseReversingAJumpAndATurnGiveTheFullSweepsPoses) 
   expect_tracking_changes_nothing(c, 0.65);
   if (c.frames > 86) {
     EXPECT_GE(c.track_failed, 1) << "the jump must fail the track";
+  }
+}
+
+// A patrol's U-turn, as the daemon's synthetic camera drives it: 1.2 m/s
+// along a lane, then at once a turn of 0.6 m radius (the yaw rate steps
+// from 0 to 2 rad/s between two frames), then the next lane.
+XPose patrol_turn_pose(int k) {
+  constexpr double kSpeed_mps = 1.2, kRadius_m = 0.6, kTurnStart_s = 1.0;
+  const double t_s = k / 30.0;
+  const XPose start{1.0, 1.5, 0.0};
+  if (t_s < kTurnStart_s) return {start.x_m + kSpeed_mps * t_s, start.y_m, 0.0};
+  const double turn_s = kPi * kRadius_m / kSpeed_mps;
+  const double cx = start.x_m + kSpeed_mps * kTurnStart_s, cy = start.y_m + kRadius_m;
+  if (t_s < kTurnStart_s + turn_s) {
+    const double a = kSpeed_mps * (t_s - kTurnStart_s) / kRadius_m;
+    return {cx + kRadius_m * std::sin(a), cy - kRadius_m * std::cos(a), a};
+  }
+  return {cx - kSpeed_mps * (t_s - kTurnStart_s - turn_s), cy + kRadius_m, kPi};
+}
+
+// After the turn's sudden start the tracking plan follows the last two
+// measurements' motion, which is right again a frame later, while the
+// filter's prediction rings for four or five frames. Measured (2026-12-07,
+// 90 frames, edge-tracked): 9 frames swept whole as uncertain with the
+// filter's prediction alone, 3 with the plan taking the prediction that
+// erred less last frame; 77 of 90 tracked (71); every frame valid both
+// ways.
+//
+// Not asserted here: the tracked poses' largest difference from the whole
+// sweep's. One level frame before the turn (25) chooses a free tilt at
+// chi² 33.8 (lsq_tilt_select_chi2 is 30; its neighbours are at 16-21) and
+// lies 2.6 mm off with either prediction: the per-frame tilt decision's
+// known trade-off (docs/decisions.md), not the plan's. Every other tracked
+// pose is within 0.4 mm of the truth.
+TEST(TrackedLocalizer, AfterATurnsSuddenStartTheTrackFollowsTheLastMeasurementsMotion) {
+  const int frames = testing::accuracy_frames(90);
+  const Compared c = compare(frames, PixelFormat::kRgb24, {}, true, patrol_turn_pose);
+  EXPECT_GE(c.tracked, static_cast<int>(0.55 * (c.frames - kWarmUpFrames)));
+  EXPECT_EQ(c.valid_only_tracked, 0) << "a pose where the whole frame gave none";
+  EXPECT_EQ(c.valid_tracked, c.valid_full) << "tracking lost frames";
+  if (frames == 90) {
+    EXPECT_LE(c.uncertain, 5) << "whole sweeps after the turn's start";
+    EXPECT_GE(c.tracked, 75);
   }
 }
 
