@@ -71,7 +71,9 @@ const Localization& Localizer::localize(const ImageView& image, const FrameInfo&
   // readout's motion and for the tracking windows.
   has_prediction_ = filter && predict_motion(filter_.motion(), frame.timestamp_ns, &predicted_) ==
                                   PredictOutcome::kOk;
-  extrapolate(frame.timestamp_ns);
+  // Only a tracking plan chooses between the two (plan_sweep).
+  has_extrapolation_ = false;
+  if (filter && config.detector.tracking) extrapolate(frame.timestamp_ns);
   const CameraMotion motion = readout_motion();
   FullSweepReason sweep = plan_sweep();
   out_.swept_px = 0;
