@@ -115,9 +115,19 @@ int find_root(std::vector<int>& parent, int a) {
   return a;
 }
 
+int nearest_node(double along_m, const CeilingLayout& layout) {
+  return static_cast<int>(std::lround(along_m / layout.grid_m));
+}
+
 // Where each whole marker of each frame says it is, from the frame's own
 // pose: sightings near the marker's nominal spot are of it, sightings far
-// from it of another marker printed with the same code.
+// from it near another node of another marker printed with the same code.
+// A sighting far from its spot yet nearest the spot's own node is neither:
+// a second print is glued at another node, and the marker itself cannot lie
+// that far off (positioning's grid consistency, grid_tolerance_units = 0.3
+// of 0.61 m, refuses it before a survey sees it), so the frame's pose is
+// off. Reported as "printed twice" (3 frames near their own node, session
+// 14), such sightings sent someone looking for a marker that is not there.
 void sort_sightings(const PipelineConfig& config, const std::vector<SurveyFrame>& frames,
                     const SurveyOptions& options, std::vector<Sighting>* home,
                     SurveyReport* report) {
@@ -153,8 +163,10 @@ void sort_sightings(const PipelineConfig& config, const std::vector<SurveyFrame>
         home->push_back({f, k, m.code_j * codes + m.code_i});
         continue;
       }
-      Away& a = away[{m.code_i, m.code_j, static_cast<int>(std::lround(x / layout.grid_m)),
-                      static_cast<int>(std::lround(y / layout.grid_m))}];
+      const int node_i = nearest_node(x, layout), node_j = nearest_node(y, layout);
+      if (node_i == nearest_node(home_x, layout) && node_j == nearest_node(home_y, layout))
+        continue;
+      Away& a = away[{m.code_i, m.code_j, node_i, node_j}];
       a.x_sum += x;
       a.y_sum += y;
       ++a.frames;

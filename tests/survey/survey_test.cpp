@@ -122,6 +122,24 @@ TEST_F(Survey, RecoversAHandLaidCeilingAndNamesTheCodePrintedTwice) {
   EXPECT_LT(report->rms_px, 0.1);
   EXPECT_GT(report->initial_rms_px, 3.0) << "the nominal grid should not fit this ceiling";
 
+  // Five frames whose poses are 0.25 m off see each of their markers that
+  // far from its spot, yet nearest its own node: not a second print (that
+  // is glued at another node), the frames' poses. Before they were told
+  // apart, every code of those frames was "printed twice".
+  std::vector<SurveyFrame> off = walk.frames;
+  int off_sightings = 0;
+  for (size_t f = 50; f < 55; ++f) {
+    off[f].robot.x_m += 0.25;
+    off_sightings += static_cast<int>(off[f].markers.size());
+  }
+  ASSERT_GE(off_sightings, 15);
+  auto off_report = survey_ceiling(config_, off, options_);
+  ASSERT_TRUE(off_report) << off_report.error().message;
+  ASSERT_EQ(off_report->duplicates.size(), 1u);
+  EXPECT_EQ(off_report->duplicates[0].code_i, 2);
+  EXPECT_EQ(off_report->duplicates[0].code_j, 1);
+  EXPECT_LE(compare(laid_->truth_map(), off_report->map).max_m, 0.0005);
+
   // Other frames under the same ceiling, against the map and without it.
   const Walk test = run("nominal", 100, 5, laid_, config_, config_.intrinsics);
   PipelineConfig mapped = config_;
