@@ -97,6 +97,12 @@ class Localizer {
   // Frames swept whole are found at half resolution first
   // (detector.halve_whole_sweeps, Pipeline::process_halved).
   bool halved_sweeps_ = false;
+  // Whether the last frame decoded whole (centroids and edges) that
+  // decided the tilt freed it. Edge points alone (a tracked or a halved
+  // sweep's) free the tilt only after such a frame did: on edges along the
+  // pixel grid they carry a bias that a tilt's keystone partly explains
+  // (docs/decisions.md "A free tilt is confirmed by a whole decode").
+  bool decode_freed_tilt_ = false;
   RefusalHistogram refusals_;
 
   // The filter's motion at this frame's time (predicted_) moved to the
@@ -107,6 +113,11 @@ class Localizer {
   FullSweepReason plan_sweep();
   // Whether a tracked sweep found what the plan expected.
   bool tracked_sweep_held() const;
+  // The last sweep measured edge points alone and freed the tilt on them,
+  // which no whole decode has confirmed.
+  bool edges_alone_freed_tilt() const;
+  // After a whole decode: the tilt decision it made, if any.
+  void remember_tilt_decision();
 };
 
 }  // namespace ceilpose
