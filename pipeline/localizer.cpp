@@ -44,7 +44,8 @@ Localizer::Localizer(const PipelineConfig& config)
       view_(config),
       decoded_last_(static_cast<size_t>(view_.map().codes()) * view_.map().codes(), 0),
       result_(std::make_unique<FrameResult>()),
-      halved_sweeps_(halved_sweeps(pipeline_)) {}
+      halved_sweeps_(halved_sweeps(pipeline_)),
+      planned_mount_(config.mount) {}
 
 void Localizer::reconfigure(const PipelineConfig& config, bool reset_filter) {
   pipeline_.set_config(config);
@@ -54,6 +55,7 @@ void Localizer::reconfigure(const PipelineConfig& config, bool reset_filter) {
   last_decoded_count_ = 0;
   frames_since_full_ = 0;
   decode_freed_tilt_ = false;  // another mount, perhaps
+  planned_mount_ = config.mount;
   if (reset_filter) {
     filter_ = TemporalFilter(config.filter);
     prediction_errors_.reset();
@@ -163,6 +165,7 @@ const Localization& Localizer::localize(const ImageView& image, const FrameInfo&
   const bool last_measured_before = last_measured_;
   last_measured_ = out_.measured.valid;
   remember_decoded();
+  remember_fitted_tilt();
   auto add_error = [&](const MotionState& s, PredictionErrors* errors) {
     errors->add(std::hypot(out_.measured.pose.x_m - s.x[0], out_.measured.pose.y_m - s.x[1]),
                 wrap_angle_rad(out_.measured.pose.yaw_rad - s.x[2]));
@@ -255,11 +258,11 @@ FullSweepReason Localizer::plan_sweep() {
                                     prediction_error_px(view_, extrapolation_errors_) <
                                         prediction_error_px(view_, prediction_errors_);
   if (extrapolation_better) {
-    return plan_tracking(view_, c.detector, c.positioning.mode, extrapolated_,
+    return plan_tracking(view_, planned_mount_, c.detector, c.positioning.mode, extrapolated_,
                          extrapolation_errors_, &plan_);
   }
-  return plan_tracking(view_, c.detector, c.positioning.mode, predicted_, prediction_errors_,
-                       &plan_);
+  return plan_tracking(view_, planned_mount_, c.detector, c.positioning.mode, predicted_,
+                       prediction_errors_, &plan_);
 }
 
 // A tracked sweep stands only when it decoded again every marker the last
@@ -302,6 +305,18 @@ void Localizer::remember_tilt_decision() {
   if (!r.estimate.valid || r.estimate.mode != PositioningMode::kLeastSquares) return;
   const TiltChoice choice = pipeline_.positioner().last_lsq().tilt_choice;
   if (choice != TiltChoice::kNotAllowed) decode_freed_tilt_ = choice == TiltChoice::kFreeFits;
+}
+
+// The pose the filter carries was fitted with this tilt: predicted with
+// it, the markers fall where that fit saw them.
+void Localizer::remember_fitted_tilt() {
+  const FrameResult& r = *result_;
+  if (!r.estimate.valid || r.estimate.mode != PositioningMode::kLeastSquares) return;
+  const LsqResult& fit = pipeline_.positioner().last_lsq();
+  const CameraMount& configured = pipeline_.config().mount;
+  const bool freed = fit.tilt_estimated && std::isfinite(fit.tilt_x_rad + fit.tilt_y_rad);
+  planned_mount_.tilt_x_rad = freed ? fit.tilt_x_rad : configured.tilt_x_rad;
+  planned_mount_.tilt_y_rad = freed ? fit.tilt_y_rad : configured.tilt_y_rad;
 }
 
 void Localizer::remember_decoded() {

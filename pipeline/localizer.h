@@ -103,6 +103,11 @@ class Localizer {
   // pixel grid they carry a bias that a tilt's keystone partly explains
   // (docs/decisions.md "A free tilt is confirmed by a whole decode").
   bool decode_freed_tilt_ = false;
+  // The mount the tracking plan predicts with: the configured one, its
+  // tilt as the last measurement's fit freed it (a camera tilted 23 mrad
+  // past its calibration put every predicted marker 12 px and more off).
+  CameraMount planned_mount_;
+  void remember_fitted_tilt();
   RefusalHistogram refusals_;
 
   // The filter's motion at this frame's time (predicted_) moved to the

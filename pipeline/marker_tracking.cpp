@@ -40,14 +40,14 @@ namespace {
 
 // The affine view of marker `p`'s frame (pixels per metre East and North at
 // its centre, over 1 cm) seen from the robot's pose `s` advanced by tau_s
-// along its arc; false when a point does not project.
-bool marker_frame_at(const ViewGeometry& view, const MarkerPlacement& p, const MotionState& s,
-                     double tau_s, MarkerFrame* out) {
+// along its arc, the camera on `mount`; false when a point does not project.
+bool marker_frame_at(const ViewGeometry& view, const CameraMount& mount, const MarkerPlacement& p,
+                     const MotionState& s, double tau_s, MarkerFrame* out) {
   constexpr double kStep_m = 0.01;
   double arc_x_m = 0.0, arc_y_m = 0.0;
   arc_displacement(s.x[3], s.x[4], s.x[5], tau_s, &arc_x_m, &arc_y_m);
   const Pose2D robot{s.x[0] + arc_x_m, s.x[1] + arc_y_m, s.x[2] + s.x[5] * tau_s};
-  const CameraPose camera = camera_pose_from_robot(robot, view.mount());
+  const CameraPose camera = camera_pose_from_robot(robot, mount);
   const double points_m[3][2] = {{0.0, 0.0}, {kStep_m, 0.0}, {0.0, kStep_m}};
   double u[3], v[3];
   const MarkerPlacement::Rotation rotation = p.rotation();
@@ -79,13 +79,14 @@ double prediction_error_px(const ViewGeometry& view, const PredictionErrors& err
   return errors.position_m() * px_per_m + errors.yaw_rad() * half_diagonal_px;
 }
 
-FullSweepReason plan_tracking(const ViewGeometry& view, const DetectorParams& params,
-                              PositioningMode mode, const MotionState& s,
-                              const PredictionErrors& errors, TrackingPlan* plan) {
+FullSweepReason plan_tracking(const ViewGeometry& view, const CameraMount& mount,
+                              const DetectorParams& params, PositioningMode mode,
+                              const MotionState& s, const PredictionErrors& errors,
+                              TrackingPlan* plan) {
   const CameraIntrinsics& k = view.intrinsics();
   const CeilingLayout& layout = view.layout();
   const Pose2D robot{s.x[0], s.x[1], s.x[2]};
-  const CameraPose camera = camera_pose_from_robot(robot, view.mount());
+  const CameraPose camera = camera_pose_from_robot(robot, mount);
   const double px_per_m = std::max(k.fx, k.fy) / view.depth_m();
   // The margin: a fixed part (blur, edge quantisation, the model's own
   // error), the recent predictions' largest errors in position and, at the
@@ -113,7 +114,7 @@ FullSweepReason plan_tracking(const ViewGeometry& view, const DetectorParams& pa
   const double marker_radius_m = std::hypot(layout.rect_width_m, 0.5 * layout.rect_height_m);
   const double reach_m = (half_diagonal_px + margin_px) / px_per_m + marker_radius_m;
   const double tilt_reach_m =
-      view.depth_m() * std::tan(std::hypot(view.mount().tilt_x_rad, view.mount().tilt_y_rad));
+      view.depth_m() * std::tan(std::hypot(mount.tilt_x_rad, mount.tilt_y_rad));
   const double reach2_m2 = (reach_m + tilt_reach_m) * (reach_m + tilt_reach_m);
   const CeilingMap& map = view.map();
   const int codes = map.codes();
@@ -196,9 +197,10 @@ FullSweepReason plan_tracking(const ViewGeometry& view, const DetectorParams& pa
           PredictedMarker& pm = plan->predicted[static_cast<size_t>(plan->predicted_count)];
           pm.code_i = i;
           pm.code_j = j;
-          bool framed = marker_frame_at(view, *p, s, 0.0, &pm.frame);
+          bool framed = marker_frame_at(view, mount, *p, s, 0.0, &pm.frame);
           if (framed && k.readout_ms > 0.0)
-            framed = marker_frame_at(view, *p, s, row_time_s(k, pm.frame.centre_v_px), &pm.frame);
+            framed =
+                marker_frame_at(view, mount, *p, s, row_time_s(k, pm.frame.centre_v_px), &pm.frame);
           if (!framed) return FullSweepReason::kUncertain;
           ++plan->predicted_count;
         }

@@ -111,10 +111,12 @@ double prediction_error_px(const ViewGeometry& view, const PredictionErrors& err
 // Plans the windows (or, edge-tracked, the markers) for positioning `mode`
 // and the robot state `s` (predicted to the frame's time; the
 // camera's readout_ms widens them) whose predictions have erred by
-// `errors`. Returns kNone and fills `plan`, or the reason to sweep the whole
-// frame.
-FullSweepReason plan_tracking(const ViewGeometry& view, const DetectorParams& params,
-                              PositioningMode mode, const MotionState& s,
-                              const PredictionErrors& errors, TrackingPlan* plan);
+// `errors`, seen by a camera on `mount` (the view's, or its tilt as the last
+// fit freed it). Returns kNone and fills `plan`, or the reason to sweep the
+// whole frame.
+FullSweepReason plan_tracking(const ViewGeometry& view, const CameraMount& mount,
+                              const DetectorParams& params, PositioningMode mode,
+                              const MotionState& s, const PredictionErrors& errors,
+                              TrackingPlan* plan);
 
 }  // namespace ceilpose

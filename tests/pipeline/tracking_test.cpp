@@ -174,12 +174,14 @@ TEST(PlanTracking, WindowsHoldEveryWholeMarkerAndGrowWithThePredictionsErrors) {
   s.x[0] = 2.1, s.x[1] = 2.0, s.x[2] = 0.3;
   PredictionErrors errors;
   TrackingPlan plan;
-  EXPECT_EQ(plan_tracking(view, config.detector, config.positioning.mode, s, errors, &plan),
-            FullSweepReason::kNoFix)
+  EXPECT_EQ(
+      plan_tracking(view, view.mount(), config.detector, config.positioning.mode, s, errors, &plan),
+      FullSweepReason::kNoFix)
       << "no prediction has been checked yet";
   for (int k = 0; k < 6; ++k) errors.add(0.0002, 0.0002);
-  ASSERT_EQ(plan_tracking(view, config.detector, config.positioning.mode, s, errors, &plan),
-            FullSweepReason::kNone);
+  ASSERT_EQ(
+      plan_tracking(view, view.mount(), config.detector, config.positioning.mode, s, errors, &plan),
+      FullSweepReason::kNone);
   const XPose pose{2.1, 2.0, 0.3};
   const std::vector<XVisibleMarker> whole = whole_markers(XCamera{}, XMount{}, pose);
   ASSERT_GE(whole.size(), 6u);
@@ -199,9 +201,9 @@ TEST(PlanTracking, WindowsHoldEveryWholeMarkerAndGrowWithThePredictionsErrors) {
   PipelineConfig windows_only = config;
   windows_only.detector.track_edges = false;
   TrackingPlan windows_plan;
-  ASSERT_EQ(
-      plan_tracking(view, windows_only.detector, config.positioning.mode, s, errors, &windows_plan),
-      FullSweepReason::kNone);
+  ASSERT_EQ(plan_tracking(view, view.mount(), windows_only.detector, config.positioning.mode, s,
+                          errors, &windows_plan),
+            FullSweepReason::kNone);
   EXPECT_TRUE(windows_plan.predicted_span().empty()) << "nothing predicted a sweep will not read";
   EXPECT_FALSE(windows_plan.edges);
   EXPECT_TRUE(plan.edges);
@@ -210,7 +212,7 @@ TEST(PlanTracking, WindowsHoldEveryWholeMarkerAndGrowWithThePredictionsErrors) {
   // does not measure: with track_edges asked for, they plan windows.
   for (PositioningMode mode : {PositioningMode::kChangeOfAxes, PositioningMode::kBarycentric}) {
     TrackingPlan thesis_plan;
-    ASSERT_EQ(plan_tracking(view, config.detector, mode, s, errors, &thesis_plan),
+    ASSERT_EQ(plan_tracking(view, view.mount(), config.detector, mode, s, errors, &thesis_plan),
               FullSweepReason::kNone);
     EXPECT_FALSE(thesis_plan.edges) << to_string(mode);
     EXPECT_TRUE(thesis_plan.predicted_span().empty()) << to_string(mode);
@@ -234,15 +236,17 @@ TEST(PlanTracking, WindowsHoldEveryWholeMarkerAndGrowWithThePredictionsErrors) {
 
   PredictionErrors worse;
   for (int k = 0; k < 6; ++k) worse.add(0.02, 0.01);  // 20 mm and 0.6 degrees
-  ASSERT_NE(plan_tracking(view, config.detector, config.positioning.mode, s, worse, &plan),
-            FullSweepReason::kNoFix);
+  ASSERT_NE(
+      plan_tracking(view, view.mount(), config.detector, config.positioning.mode, s, worse, &plan),
+      FullSweepReason::kNoFix);
   EXPECT_GT(plan.margin_px,
             small_margin_px +
                 config.detector.track_margin_errors * (0.02 - 0.0002) * 530.0 / 2.1336 - 0.5);
   PredictionErrors lost;
   for (int k = 0; k < 6; ++k) lost.add(0.5, 0.5);
-  EXPECT_EQ(plan_tracking(view, config.detector, config.positioning.mode, s, lost, &plan),
-            FullSweepReason::kUncertain);
+  EXPECT_EQ(
+      plan_tracking(view, view.mount(), config.detector, config.positioning.mode, s, lost, &plan),
+      FullSweepReason::kUncertain);
 }
 
 // No margin until the filter has settled: three predictions skipped, three
@@ -258,7 +262,8 @@ TEST(PlanTracking, TheLastPredictionsErrorSizesTheMarginOnceTheFilterHasSettled)
   s.x[0] = 2.1, s.x[1] = 2.0, s.x[2] = 0.3;
   TrackingPlan plan;
   auto plan_with = [&](const PredictionErrors& errors) {
-    return plan_tracking(view, config.detector, config.positioning.mode, s, errors, &plan);
+    return plan_tracking(view, view.mount(), config.detector, config.positioning.mode, s, errors,
+                         &plan);
   };
   PredictionErrors errors;
   for (int k = 0; k < 5; ++k) {
@@ -296,19 +301,22 @@ TEST(PlanTracking, AnEdgeTrackedPlanAllowsForTheReadoutWithinAMarkerOnly) {
   s.x[0] = 2.1, s.x[1] = 2.0, s.x[2] = 0.3;
   s.x[5] = 3.0;  // rad/s
   TrackingPlan plan;
-  EXPECT_EQ(plan_tracking(view, config.detector, config.positioning.mode, s, errors, &plan),
-            FullSweepReason::kNone);
+  EXPECT_EQ(
+      plan_tracking(view, view.mount(), config.detector, config.positioning.mode, s, errors, &plan),
+      FullSweepReason::kNone);
   EXPECT_GT(plan.predicted_count, 0);
   // The windows' margin holds half the readout's turn at the frame's corner.
   const double half_diagonal_px = 0.5 * std::hypot(640.0, 480.0);
   EXPECT_GE(plan.margin_px, config.detector.track_margin_px + 3.0 * half_diagonal_px * 0.0125);
   s.x[5] = 8.0;
-  EXPECT_EQ(plan_tracking(view, config.detector, config.positioning.mode, s, errors, &plan),
-            FullSweepReason::kUncertain);
+  EXPECT_EQ(
+      plan_tracking(view, view.mount(), config.detector, config.positioning.mode, s, errors, &plan),
+      FullSweepReason::kUncertain);
   // A global shutter has no readout to allow for at any turn rate.
   config.intrinsics.readout_ms = 0.0;
   const ViewGeometry global(config);
-  EXPECT_EQ(plan_tracking(global, config.detector, config.positioning.mode, s, errors, &plan),
+  EXPECT_EQ(plan_tracking(global, global.mount(), config.detector, config.positioning.mode, s,
+                          errors, &plan),
             FullSweepReason::kNone);
 }
 
@@ -328,8 +336,8 @@ EdgeTrackedScene edge_tracked_scene(const XPose& pose) {
   s.x[0] = pose.x_m, s.x[1] = pose.y_m, s.x[2] = pose.yaw_rad;
   PredictionErrors errors;
   for (int k = 0; k < 6; ++k) errors.add(0.0002, 0.0002);
-  EXPECT_EQ(plan_tracking(view, scene.config.detector, scene.config.positioning.mode, s, errors,
-                          &scene.plan),
+  EXPECT_EQ(plan_tracking(view, view.mount(), scene.config.detector, scene.config.positioning.mode,
+                          s, errors, &scene.plan),
             FullSweepReason::kNone);
   XRenderOptions options;
   options.noise_sigma = 2.0;
@@ -652,26 +660,26 @@ TEST(TrackedLocalizer, AfterATurnsSuddenStartTheTrackFollowsTheLastMeasurementsM
   }
 }
 
-// The other side of that rule: a camera tilted past its calibration
-// (the configured mount level, the rendered one tilted 9.4 mrad) has its
-// tilt freed by the first whole decode, and then by its edge-tracked frames
-// too, which keep tracking. Measured (2026-12-07, 60 frames): 48 tracked,
-// every frame valid both ways, the largest difference from the whole sweep
-// 0.99 mm, p99 1.18 mm against the whole sweep's 1.20 mm (before edges
-// alone had to be confirmed: 2.76 mm and 3.55 mm, from the filter's first
-// frames). At 23 mrad the tracks fail on every frame (the plan predicts
-// with the configured mount) and every frame is swept whole.
+// The other side of that rule: a camera tilted past its calibration (the
+// configured mount level, the rendered one tilted 23 mrad) has its tilt
+// freed by the first whole decode, and then by its edge-tracked frames too,
+// which keep tracking: the plan predicts the markers with the tilt the
+// last fit freed. Measured (2026-12-07, 60 frames): 49 tracked (0 when
+// planned with the configured mount: every predicted marker 12 px and more
+// off), every frame valid both ways, the tracked frames' median error
+// 0.207 mm against the whole sweep's 0.522 mm; the largest difference 2.1 mm
+// (a free tilt's own sigma is 1-3 mm, docs/accuracy.md).
 TEST(TrackedLocalizer, ACameraTiltedPastItsCalibrationTracksWithItsTiltFreed) {
   XMount tilted;
-  tilted.tilt_x_rad = 0.008;
-  tilted.tilt_y_rad = -0.005;
+  tilted.tilt_x_rad = 0.02;
+  tilted.tilt_y_rad = -0.012;
   const Compared c =
       compare(testing::accuracy_frames(60), PixelFormat::kRgb24, {}, true, path_pose, tilted);
   EXPECT_GE(c.tracked, static_cast<int>(0.55 * (c.frames - kWarmUpFrames)));
   EXPECT_EQ(c.valid_only_tracked, 0) << "a pose where the whole frame gave none";
   EXPECT_EQ(c.valid_tracked, c.valid_full) << "tracking lost frames";
-  EXPECT_LE(c.max_difference_mm, 1.2);
-  EXPECT_LE(p99(c.error_tracked_mm), p99(c.error_full_mm) + 0.05);
+  EXPECT_LE(c.max_difference_mm, 2.5);
+  EXPECT_LE(median(c.paired_tracked_mm), median(c.paired_full_mm));
   EXPECT_GE(c.tracked_free_tilt, static_cast<int>(0.9 * c.tracked));
 }
 
