@@ -87,6 +87,11 @@ struct CameraPriors {
 constexpr double kMinMapSigmaM = 0.0001;
 constexpr double kMinMapSigmaRad = 0.0002;
 
+// A frame's pose stands, for a sighting of a marker far off its spot, when
+// at least this many of its markers are at their spots, and more of them
+// than are off.
+constexpr int kMinMarkersAtSpot = 2;
+
 struct Sighting {
   int frame;
   int marker;  // index into the frame's markers
@@ -122,12 +127,16 @@ int nearest_node(double along_m, const CeilingLayout& layout) {
 // Where each whole marker of each frame says it is, from the frame's own
 // pose: sightings near the marker's nominal spot are of it, sightings far
 // from it near another node of another marker printed with the same code.
-// A sighting far from its spot yet nearest the spot's own node is neither:
-// a second print is glued at another node, and the marker itself cannot lie
-// that far off (positioning's grid consistency, grid_tolerance_units = 0.3
-// of 0.61 m, refuses it before a survey sees it), so the frame's pose is
-// off. Reported as "printed twice" (3 frames near their own node, session
-// 14), such sightings sent someone looking for a marker that is not there.
+// A sighting far from its spot yet nearest the spot's own node is either the
+// marker glued that far off, or a frame whose pose was off. Positioning's
+// grid consistency (grid_tolerance_units = 0.3 of 0.61 m) refuses a marker
+// more than 0.18 m off, so a frame whose other markers are at their spots
+// had its pose from them and sees that marker where it is: it is mapped
+// there (against a known map, which holds its places, it is left out: it
+// has moved since). A frame that sees most of its markers far off had its
+// pose off: such sightings are left out, and not reported as "printed
+// twice" (3 frames near their own node did, session 14, and sent someone
+// looking for a marker that is not there).
 void sort_sightings(const PipelineConfig& config, const std::vector<SurveyFrame>& frames,
                     const SurveyOptions& options, std::vector<Sighting>* home,
                     SurveyReport* report) {
@@ -139,10 +148,13 @@ void sort_sightings(const PipelineConfig& config, const std::vector<SurveyFrame>
     int frames = 0;
   };
   std::map<std::array<int, 4>, Away> away;  // code i, j, nearest node i, j
+  std::vector<Sighting> off_spot;           // one frame's, far off but by their own node
   for (int f = 0; f < static_cast<int>(frames.size()); ++f) {
     const SurveyFrame& frame = frames[static_cast<size_t>(f)];
     const CameraPose cam = camera_pose_from_robot(frame.robot, config.mount);
     const double yaw = frame.robot.yaw_rad + config.mount.yaw_rad;
+    off_spot.clear();
+    int at_spot = 0;
     for (int k = 0; k < static_cast<int>(frame.markers.size()); ++k) {
       const MarkerObservation& m = frame.markers[static_cast<size_t>(k)];
       if (!m.whole || m.code_i < 0 || m.code_j < 0 || m.code_i >= codes || m.code_j >= codes)
@@ -159,18 +171,27 @@ void sort_sightings(const PipelineConfig& config, const std::vector<SurveyFrame>
         home_x = p->x_m;
         home_y = p->y_m;
       }
+      const Sighting sighting{f, k, m.code_j * codes + m.code_i};
       if (std::hypot(x - home_x, y - home_y) <= options.duplicate_distance_m) {
-        home->push_back({f, k, m.code_j * codes + m.code_i});
+        home->push_back(sighting);
+        ++at_spot;
         continue;
       }
       const int node_i = nearest_node(x, layout), node_j = nearest_node(y, layout);
-      if (node_i == nearest_node(home_x, layout) && node_j == nearest_node(home_y, layout))
+      if (node_i == nearest_node(home_x, layout) && node_j == nearest_node(home_y, layout)) {
+        off_spot.push_back(sighting);
         continue;
+      }
       Away& a = away[{m.code_i, m.code_j, node_i, node_j}];
       a.x_sum += x;
       a.y_sum += y;
       ++a.frames;
     }
+    // Against a known map (calibrate robot) its places are held: a marker
+    // that far from its mapped place has moved since, and is left out.
+    if (options.known_map == nullptr && at_spot >= kMinMarkersAtSpot &&
+        at_spot > static_cast<int>(off_spot.size()))
+      home->insert(home->end(), off_spot.begin(), off_spot.end());
   }
   for (const auto& [key, a] : away) {
     if (a.frames < options.min_frames) continue;  // a stray misreading, not a marker
