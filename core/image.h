@@ -21,6 +21,14 @@ struct Rgb {
 
 enum class PixelFormat : uint8_t { kGray8, kRgb24, kBgr24, kYuyv, kMjpeg, kNv12, kYuv420 };
 
+// YUYV (V4L2_PIX_FMT_YUYV): two pixels in four bytes, Y0 U Y1 V. Pixel x's
+// luma is byte 2x of its row; its pair, from byte kYuyvPairBytes * (x / 2),
+// holds the chroma both share.
+inline constexpr int kYuyvPairBytes = 4;
+inline constexpr int kYuyvUByte = 1;  // of a pair
+inline constexpr int kYuyvVByte = 3;
+inline constexpr int kYuyvSecondLumaByte = 2;
+
 // Bytes per pixel of a row; for the 4:2:0 formats, of the luma plane's row.
 inline int bytes_per_pixel(PixelFormat f) {
   switch (f) {

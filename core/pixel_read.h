@@ -86,8 +86,8 @@ inline Rgb pixel_rgb(const ImageView& f, int x, int y) {
   } else if constexpr (F == PixelFormat::kBgr24) {
     c = {p[3 * x + 2], p[3 * x + 1], p[3 * x]};
   } else if constexpr (F == PixelFormat::kYuyv) {
-    const uint8_t* q = p + 4 * (x / 2);
-    yuv_to_rgb(q[(x & 1) * 2], q[1], q[3], &c.r, &c.g, &c.b);
+    const uint8_t* q = p + kYuyvPairBytes * (x / 2);
+    yuv_to_rgb(p[2 * x], q[kYuyvUByte], q[kYuyvVByte], &c.r, &c.g, &c.b);
   } else if constexpr (F == PixelFormat::kNv12) {
     const uint8_t* uv = f.uv_row(y) + (x & ~1);
     yuv_to_rgb(p[x], uv[0], uv[1], &c.r, &c.g, &c.b);
@@ -104,8 +104,8 @@ template <PixelFormat F>
 inline uint8_t pixel_darkest(const ImageView& f, int x, int y) {
   const uint8_t* p = f.row(y);
   if constexpr (F == PixelFormat::kYuyv) {
-    const uint8_t* q = p + 4 * (x / 2);
-    return yuv_darkest(q[(x & 1) * 2], q[1], q[3]);
+    const uint8_t* q = p + kYuyvPairBytes * (x / 2);
+    return yuv_darkest(p[2 * x], q[kYuyvUByte], q[kYuyvVByte]);
   } else if constexpr (F == PixelFormat::kNv12) {
     const uint8_t* uv = f.uv_row(y) + (x & ~1);
     return yuv_darkest(p[x], uv[0], uv[1]);
@@ -246,7 +246,8 @@ inline void read_rgb_interpolated(const ImageView& f, int x, int y, uint8_t* r, 
     luma = p[2 * x];
     for (int k = 0; k < 2; ++k) {
       const int pair = k == 0 ? own : other;
-      u4[k] = 4 * p[4 * pair + 1], v4[k] = 4 * p[4 * pair + 3];
+      const uint8_t* q = p + kYuyvPairBytes * pair;
+      u4[k] = 4 * q[kYuyvUByte], v4[k] = 4 * q[kYuyvVByte];
     }
   } else {
     luma = f.row(y)[x];

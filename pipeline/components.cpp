@@ -61,8 +61,8 @@ int64_t sum_squares_to(int64_t k) { return k * (k + 1) * (2 * k + 1) / 6; }
 CEILPOSE_VECTOR_CLONES void yuyv_chroma(const uint8_t* __restrict q, int16_t* __restrict u4,
                                         int16_t* __restrict v4, int pairs) {
   for (int k = 0; k < pairs; ++k) {
-    u4[k] = static_cast<int16_t>(4 * q[4 * k + 1]);
-    v4[k] = static_cast<int16_t>(4 * q[4 * k + 3]);
+    u4[k] = static_cast<int16_t>(4 * q[kYuyvPairBytes * k + kYuyvUByte]);
+    v4[k] = static_cast<int16_t>(4 * q[kYuyvPairBytes * k + kYuyvVByte]);
   }
 }
 CEILPOSE_VECTOR_CLONES void yuyv_luma(const uint8_t* __restrict q, int16_t* __restrict luma,
@@ -101,10 +101,10 @@ CEILPOSE_VECTOR_CLONES void yuyv_sampled(const uint8_t* __restrict q, int pairs,
                                          int16_t* __restrict luma, int16_t* __restrict u16,
                                          int16_t* __restrict v16, int n) {
   for (int i = 0; i < n; ++i) {
-    const uint8_t* p = q + 4 * pairs * i;
+    const uint8_t* p = q + kYuyvPairBytes * pairs * i;
     luma[i] = p[0];
-    u16[i] = static_cast<int16_t>(16 * p[1]);
-    v16[i] = static_cast<int16_t>(16 * p[3]);
+    u16[i] = static_cast<int16_t>(16 * p[kYuyvUByte]);
+    v16[i] = static_cast<int16_t>(16 * p[kYuyvVByte]);
   }
 }
 // The same from 4:2:0 planes: chroma samples `step` bytes apart (NV12 2,
@@ -765,7 +765,7 @@ void ComponentLabeler::classify_sampled_row(const ImageView& frame, int y, int s
                                                             : frame.v_row(y);
       auto convert = [&](int b, int e) {
         if (frame.format == PixelFormat::kYuyv) {
-          yuyv_sampled(row + 4 * pairs * b, pairs, py + b, pu + b, pv + b, e - b);
+          yuyv_sampled(row + kYuyvPairBytes * pairs * b, pairs, py + b, pu + b, pv + b, e - b);
         } else {
           const int c = chroma_step * pairs * b;
           planar_sampled(row + 2 * pairs * b, pairs, u + c, v + c, chroma_step, py + b, pu + b,

@@ -74,14 +74,15 @@ Brightness yuyv_brightness(const ImageView& frame, int x0, int y0, const double 
                  &out);
   };
   for (int row = 0; row < 2; ++row) {
-    const uint8_t* q = frame.row(y0 + row) + 4 * pair;
-    const YuvChromaParts own = yuv_chroma_parts(q[1], q[3]);
+    const uint8_t* q = frame.row(y0 + row) + kYuyvPairBytes * pair;
+    const uint8_t* next = q + kYuyvPairBytes;
+    const YuvChromaParts own = yuv_chroma_parts(q[kYuyvUByte], q[kYuyvVByte]);
     if ((x0 & 1) == 0) {
       add(q[0], own, w[2 * row]);
-      add(q[2], own, w[2 * row + 1]);
+      add(q[kYuyvSecondLumaByte], own, w[2 * row + 1]);
     } else {
-      add(q[2], own, w[2 * row]);
-      add(q[4], yuv_chroma_parts(q[5], q[7]), w[2 * row + 1]);
+      add(q[kYuyvSecondLumaByte], own, w[2 * row]);
+      add(next[0], yuv_chroma_parts(next[kYuyvUByte], next[kYuyvVByte]), w[2 * row + 1]);
     }
   }
   return out;

@@ -69,9 +69,7 @@ void convert_rgb(const Image& rgb, PixelFormat format, Image* out_image) {
           d[3 * x] = s[3 * x + 2], d[3 * x + 1] = s[3 * x + 1], d[3 * x + 2] = s[3 * x];
         break;
       case PixelFormat::kGray8:
-        for (int x = 0; x < w; ++x)
-          d[x] = static_cast<uint8_t>(
-              (77 * s[3 * x] + 150 * s[3 * x + 1] + 29 * s[3 * x + 2] + 128) >> 8);
+        for (int x = 0; x < w; ++x) d[x] = rgb_luma(s[3 * x], s[3 * x + 1], s[3 * x + 2]);
         break;
       case PixelFormat::kYuyv:
         for (int x = 0; x < w; x += 2) {
@@ -81,11 +79,12 @@ void convert_rgb(const Image& rgb, PixelFormat format, Image* out_image) {
           const int r = s[3 * x], g = s[3 * x + 1], b = s[3 * x + 2];
           const double r2 = 0.5 * (r + s[3 * x2]), g2 = 0.5 * (g + s[3 * x2 + 1]),
                        b2 = 0.5 * (b + s[3 * x2 + 2]);
-          d[2 * x] = rgb_to_y(r, g, b);
-          d[2 * x + 1] = rgb_to_u(r2, g2, b2);
+          uint8_t* pair = d + 2 * x;  // x is even: a pair's first byte
+          pair[0] = rgb_to_y(r, g, b);
+          pair[kYuyvUByte] = rgb_to_u(r2, g2, b2);
           if (x + 1 < w) {
-            d[2 * x + 2] = rgb_to_y(s[3 * x2], s[3 * x2 + 1], s[3 * x2 + 2]);
-            d[2 * x + 3] = rgb_to_v(r2, g2, b2);
+            pair[kYuyvSecondLumaByte] = rgb_to_y(s[3 * x2], s[3 * x2 + 1], s[3 * x2 + 2]);
+            pair[kYuyvVByte] = rgb_to_v(r2, g2, b2);
           }
         }
         break;
