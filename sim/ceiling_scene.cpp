@@ -54,10 +54,25 @@ CeilingScene::CeilingScene(const CeilingLayout& layout, uint64_t seed,
       seed_(seed),
       inv_grid_(1.0 / layout.grid_m),
       half_w_m_(layout.rect_width_m),
-      half_h_m_(0.5 * layout.rect_height_m) {
+      half_h_m_(0.5 * layout.rect_height_m),
+      marker_reach_m_(std::hypot(half_w_m_, half_h_m_)) {
   auto lin = [](Rgb c) {
     return LinearRgb{srgb_to_linear(c.r), srgb_to_linear(c.g), srgb_to_linear(c.b)};
   };
+  if (laid_ != nullptr) {
+    // How far past its node's half grid the farthest-reaching marker goes,
+    // in whole grid steps.
+    double past_m = 0.0;
+    for (int j = 0; j < laid_->side(); ++j)
+      for (int i = 0; i < laid_->side(); ++i) {
+        const LaidMarker& m = laid_->at(i, j);
+        if (!m.present) continue;
+        const double off_m =
+            std::max(std::abs(m.x_m - i * layout.grid_m), std::abs(m.y_m - j * layout.grid_m));
+        past_m = std::max(past_m, off_m + marker_reach_m_ - 0.5 * layout.grid_m);
+      }
+    laid_reach_nodes_ = static_cast<int>(std::ceil(past_m * inv_grid_));
+  }
   colours_[kMaterialNone] = {0.0f, 0.0f, 0.0f};
   colours_[kMaterialTile] = lin(layout.tile);
   colours_[kMaterialRail] = lin(layout.rail);

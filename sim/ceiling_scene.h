@@ -76,6 +76,9 @@ class CeilingScene {
   enum : uint8_t { kNoFixture = 0, kFixtureNorthSouth = 1, kFixtureEastWest = 2 };
 
   uint8_t marker_material(int i, int j, double e_m, double n_m) const;
+  // The material of the marker laid at node (i, j) at (x, y); kMaterialNone
+  // where it does not cover the point (or none is there).
+  uint8_t laid_material(int i, int j, double x_m, double y_m) const;
   uint8_t fixture_kind(int64_t ti, int64_t tj) const;
 
   CeilingLayout layout_;
@@ -84,6 +87,10 @@ class CeilingScene {
   double inv_grid_ = 1.0;
   double half_w_m_ = 0.0;  // marker half extents
   double half_h_m_ = 0.0;
+  double marker_reach_m_ = 0.0;  // their half diagonal
+  // Rings of grid nodes around the nearest one whose laid markers may reach
+  // a point: 0 while every marker lies within its own node's half grid.
+  int laid_reach_nodes_ = 0;
   std::array<LinearRgb, kMaterialCount> colours_{};
   std::array<ClutterObject, kMaxClutterObjects> clutter_{};
   std::array<double, 2> fixture_half_ns_{};  // half extents (E–W, N–S) of a N–S panel
@@ -122,6 +129,18 @@ inline uint8_t CeilingScene::marker_material(int i, int j, double e_m, double n_
   return red ? kMaterialRed : kMaterialGreen;
 }
 
+inline uint8_t CeilingScene::laid_material(int i, int j, double x_m, double y_m) const {
+  const LaidMarker& m = laid_->at(i, j);
+  if (!m.present) return kMaterialNone;
+  const double dx = x_m - m.x_m, dy = y_m - m.y_m;
+  // Beyond its half diagonal at any turn: no trigonometry.
+  if (std::abs(dx) > marker_reach_m_ || std::abs(dy) > marker_reach_m_) return kMaterialNone;
+  const double c = std::cos(m.yaw_rad), s = std::sin(m.yaw_rad);
+  const double me = c * dx + s * dy, mn = -s * dx + c * dy;
+  if (std::abs(me) > half_w_m_ || std::abs(mn) > half_h_m_) return kMaterialNone;
+  return marker_material(m.code_i, m.code_j, me, mn);
+}
+
 inline uint8_t CeilingScene::material_at(double x_m, double y_m, bool fixtures,
                                          int clutter_count) const {
   const double gx = x_m * inv_grid_, gy = y_m * inv_grid_;
@@ -133,16 +152,21 @@ inline uint8_t CeilingScene::material_at(double x_m, double y_m, bool fixtures,
   if (laid_ == nullptr) {
     if (on_grid && std::abs(e) <= half_w_m_ && std::abs(n) <= half_h_m_)
       return marker_material(static_cast<int>(ri), static_cast<int>(rj), e, n);
-  } else if (on_grid) {
-    // A hand-laid marker stays nearest its own node (offsets of centimetres
-    // against a 0.3 m half grid): look it up there, in its own frame.
-    const LaidMarker& m = laid_->at(static_cast<int>(ri), static_cast<int>(rj));
-    if (m.present) {
-      const double c = std::cos(m.yaw_rad), s = std::sin(m.yaw_rad);
-      const double dx = x_m - m.x_m, dy = y_m - m.y_m;
-      const double me = c * dx + s * dy, mn = -s * dx + c * dy;
-      if (std::abs(me) <= half_w_m_ && std::abs(mn) <= half_h_m_)
-        return marker_material(m.code_i, m.code_j, me, mn);
+  } else {
+    // A hand-laid marker is looked up at its own node first, in its own
+    // frame; one glued so far off that it reaches past its node's half grid
+    // also at the nodes around (laid_reach_nodes_), so it is drawn whole.
+    if (on_grid) {
+      const uint8_t own = laid_material(static_cast<int>(ri), static_cast<int>(rj), x_m, y_m);
+      if (own != kMaterialNone) return own;
+    }
+    for (int dj = -laid_reach_nodes_; dj <= laid_reach_nodes_; ++dj) {
+      for (int di = -laid_reach_nodes_; di <= laid_reach_nodes_; ++di) {
+        const double i = ri + di, j = rj + dj;
+        if ((di == 0 && dj == 0) || i < 0.0 || j < 0.0 || i >= n_codes || j >= n_codes) continue;
+        const uint8_t near = laid_material(static_cast<int>(i), static_cast<int>(j), x_m, y_m);
+        if (near != kMaterialNone) return near;
+      }
     }
   }
   for (int k = 0; k < clutter_count; ++k) {

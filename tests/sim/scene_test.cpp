@@ -3,8 +3,10 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <memory>
 
 #include "sim/ceiling_scene.h"
+#include "sim/laid_ceiling.h"
 #include "sim/visibility.h"
 
 namespace ceilpose::sim {
@@ -30,6 +32,35 @@ TEST(CeilingScene, EveryPointOfEveryMarkerIsMarkerMaterialWithFixturesAndAllClut
             ASSERT_TRUE(
                 is_marker_material(scene.material_at(c[0] + e, c[1] + n, true, kMaxClutterObjects)))
                 << "seed " << seed << " marker " << i << "," << j << " e " << e << " n " << n;
+          }
+      }
+  }
+}
+
+// A marker glued so far off its spot that it reaches past its node's half
+// grid is drawn whole, not clipped where the next node's cell begins (seeds
+// 7-14 at 0.25 m: before, the far end of the marker was tile or rail).
+TEST(CeilingScene, AHandLaidMarkerFarOffItsSpotIsDrawnWhole) {
+  const CeilingLayout layout;
+  for (uint64_t seed = 7; seed <= 14; ++seed) {
+    HandLaidOptions o;
+    o.seed = seed;
+    o.outlier_m = 0.25;
+    const auto laid = std::make_shared<const LaidCeiling>(LaidCeiling::hand_laid(layout, o));
+    const CeilingScene scene(layout, seed, laid);
+    for (int i = 0; i < laid->side(); ++i)
+      for (int j = 0; j < laid->side(); ++j) {
+        const LaidMarker& m = laid->at(i, j);
+        if (!m.present) continue;
+        const double c = std::cos(m.yaw_rad), s = std::sin(m.yaw_rad);
+        constexpr int kSteps = 16;
+        for (int a = 0; a <= kSteps; ++a)
+          for (int b = 0; b <= kSteps; ++b) {
+            const double e = (2.0 * a / kSteps - 1.0) * (layout.rect_width_m - 1e-6);
+            const double n = (1.0 * b / kSteps - 0.5) * (layout.rect_height_m - 2e-6);
+            ASSERT_TRUE(is_marker_material(scene.material_at(
+                m.x_m + c * e - s * n, m.y_m + s * e + c * n, true, kMaxClutterObjects)))
+                << "seed " << seed << " node " << i << "," << j << " e " << e << " n " << n;
           }
       }
   }

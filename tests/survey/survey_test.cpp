@@ -159,20 +159,19 @@ TEST_F(Survey, RecoversAHandLaidCeilingAndNamesTheCodePrintedTwice) {
   EXPECT_LE(test.accuracy.mean_nees, 5.0);
 }
 
-// A marker glued 0.21 m off its spot: positioning's grid consistency
+// A marker glued 0.25 m off its spot: positioning's grid consistency
 // (0.3 of a 0.61 m unit, 0.18 m) refuses it in every frame, so the frames'
-// poses come from the other markers, and most of their sightings of it lie
-// more than 0.2 m from its spot, yet nearest its own node. (The simulator
-// draws a hand-laid marker only within its node's half grid: this seed
-// puts it wholly inside, 0.150 m East and 0.141 m South.) Measured
-// (2026-12-07): mapped within 0.29 mm, the map's RMS 0.077 mm; before,
-// left out, and the map's datum (the best fit onto the nominal grid) 4.5 mm
-// RMS from the truth's, which has it. Seeds 18, 22 and 23 (the same
-// offset, their sightings mostly within 0.2 m) were mapped either way.
+// poses come from the other markers, and its sightings lie more than 0.2 m
+// from its spot, yet nearest its own node. It reaches past its node's half
+// grid, which the simulator now draws (before, its far end was clipped:
+// seeds 7, 9, 10, 11 and 14 never decoded it, 12 and 13 mapped its clipped
+// centroid 15-16 mm off). Measured (2026-12-07, seeds 7-14): mapped in
+// every one, the map's largest error 0.25-0.38 mm, RMS 0.070-0.102 mm; this
+// seed 0.384 and 0.088 mm.
 TEST_F(Survey, MapsAMarkerGluedFarOffItsSpot) {
   sim::HandLaidOptions o;
-  o.seed = 20;
-  o.outlier_m = 0.21;
+  o.seed = 12;
+  o.outlier_m = 0.25;
   const auto laid = std::make_shared<const sim::LaidCeiling>(sim::LaidCeiling::hand_laid({}, o));
   const Walk walk = run("survey_walk", 200, 11, laid, config_, config_.intrinsics);
   auto report = survey_ceiling(config_, walk.frames, options_);
@@ -182,7 +181,7 @@ TEST_F(Survey, MapsAMarkerGluedFarOffItsSpot) {
   EXPECT_EQ(e.missing, 0) << "the marker far off its spot is on the ceiling: mapped";
   EXPECT_LE(e.max_m, 0.0005);
   EXPECT_LE(e.rms_m, 0.00015);
-  EXPECT_NEAR(report->largest_shift_m, 0.206, 0.005) << "found where it is";
+  EXPECT_NEAR(report->largest_shift_m, 0.240, 0.005) << "found where it is";
   EXPECT_EQ(report->duplicates.size(), 1u) << "only the code printed twice";
 }
 
