@@ -294,29 +294,31 @@ bool Localizer::tracked_sweep_held() const {
 // whole decode has freed the tilt (a mount tilted past its calibration),
 // edge points free it again on their own.
 bool Localizer::edges_alone_freed_tilt() const {
-  const FrameResult& r = *result_;
-  return !decode_freed_tilt_ && r.estimate.valid &&
-         r.estimate.mode == PositioningMode::kLeastSquares &&
-         pipeline_.positioner().last_lsq().tilt_choice == TiltChoice::kFreeFits;
+  const LsqResult* fit = last_fit();
+  return !decode_freed_tilt_ && fit != nullptr && fit->tilt_choice == TiltChoice::kFreeFits;
 }
 
 void Localizer::remember_tilt_decision() {
+  const LsqResult* fit = last_fit();
+  if (fit != nullptr && fit->tilt_choice != TiltChoice::kNotAllowed)
+    decode_freed_tilt_ = fit->tilt_choice == TiltChoice::kFreeFits;
+}
+
+const LsqResult* Localizer::last_fit() const {
   const FrameResult& r = *result_;
-  if (!r.estimate.valid || r.estimate.mode != PositioningMode::kLeastSquares) return;
-  const TiltChoice choice = pipeline_.positioner().last_lsq().tilt_choice;
-  if (choice != TiltChoice::kNotAllowed) decode_freed_tilt_ = choice == TiltChoice::kFreeFits;
+  if (!r.estimate.valid || r.estimate.mode != PositioningMode::kLeastSquares) return nullptr;
+  return &pipeline_.positioner().last_lsq();
 }
 
 // The pose the filter carries was fitted with this tilt: predicted with
 // it, the markers fall where that fit saw them.
 void Localizer::remember_fitted_tilt() {
-  const FrameResult& r = *result_;
-  if (!r.estimate.valid || r.estimate.mode != PositioningMode::kLeastSquares) return;
-  const LsqResult& fit = pipeline_.positioner().last_lsq();
+  const LsqResult* fit = last_fit();
+  if (fit == nullptr) return;
   const CameraMount& configured = pipeline_.config().mount;
-  const bool freed = fit.tilt_estimated && std::isfinite(fit.tilt_x_rad + fit.tilt_y_rad);
-  planned_mount_.tilt_x_rad = freed ? fit.tilt_x_rad : configured.tilt_x_rad;
-  planned_mount_.tilt_y_rad = freed ? fit.tilt_y_rad : configured.tilt_y_rad;
+  const bool freed = fit->tilt_estimated && std::isfinite(fit->tilt_x_rad + fit->tilt_y_rad);
+  planned_mount_.tilt_x_rad = freed ? fit->tilt_x_rad : configured.tilt_x_rad;
+  planned_mount_.tilt_y_rad = freed ? fit->tilt_y_rad : configured.tilt_y_rad;
 }
 
 void Localizer::remember_decoded() {

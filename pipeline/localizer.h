@@ -123,6 +123,9 @@ class Localizer {
   bool edges_alone_freed_tilt() const;
   // After a whole decode: the tilt decision it made, if any.
   void remember_tilt_decision();
+  // This frame's least-squares fit; null when the frame gave no pose or was
+  // positioned another way.
+  const LsqResult* last_fit() const;
 };
 
 }  // namespace ceilpose
