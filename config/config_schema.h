@@ -223,6 +223,8 @@ void describe(V& v, ServiceConfig& c) {
     v.field("reinit_after_gated", f.reinit_after_gated, 1, 100000);
     v.field("min_frame_interval_ms", f.min_frame_interval_ms, 0.0, 1000.0);
     v.field("predict_timeout_ms", f.predict_timeout_ms, 0.0, 60000.0);
+    v.field("coast_max_sd_m", f.coast_max_sd_m, 0.0, 1000.0);
+    v.field("coast_max_yaw_sd_rad", f.coast_max_yaw_sd_rad, 0.0, 1000.0);
     v.field("init_velocity_sigma_mps", f.init_velocity_sigma_mps, 1e-6, 100.0);
     v.field("init_yaw_rate_sigma_radps", f.init_yaw_rate_sigma_radps, 1e-6, 100.0);
     v.field("init_accel_sigma_mps2", f.init_accel_sigma_mps2, 1e-6, 1000.0);

@@ -153,6 +153,18 @@ void TemporalFilter::correct(const std::array<double, 3>& y, const std::array<do
   state_.p = p;
 }
 
+PoseEstimate TemporalFilter::coast(int64_t frame_ns) {
+  ++stats_.predictions;
+  PoseEstimate out = output(nullptr, frame_ns);
+  const double var_m2 = std::max(out.covariance[0], out.covariance[4]);
+  const double max_m = params_.coast_max_sd_m, max_rad = params_.coast_max_yaw_sd_rad;
+  if (!(var_m2 <= max_m * max_m) || !(out.covariance[8] <= max_rad * max_rad)) {
+    ++stats_.too_uncertain;
+    return PoseEstimate{};
+  }
+  return out;
+}
+
 PoseEstimate TemporalFilter::update(const PoseEstimate& m, int64_t frame_ns) {
   const int64_t timestamp_ns =
       m.valid ? frame_ns + static_cast<int64_t>(std::llround(m.time_offset_s * 1e9)) : frame_ns;
@@ -177,8 +189,7 @@ PoseEstimate TemporalFilter::update(const PoseEstimate& m, int64_t frame_ns) {
   std::array<double, 3> y{};
   std::array<double, 9> s_inv{};
   if (!m.valid || !innovation(m, &y, &s_inv)) {
-    ++stats_.predictions;
-    return output(nullptr, frame_ns);
+    return coast(frame_ns);
   }
   if (gated(y, s_inv)) {
     ++stats_.gated;
@@ -190,8 +201,7 @@ PoseEstimate TemporalFilter::update(const PoseEstimate& m, int64_t frame_ns) {
       last_frame_ns_ = frame_ns;
       return output(&m, frame_ns);
     }
-    ++stats_.predictions;
-    return output(nullptr, frame_ns);
+    return coast(frame_ns);
   }
   correct(y, s_inv);
   consecutive_gated_ = 0;

@@ -18,6 +18,7 @@ struct FilterStats {
   uint64_t gated = 0;              // measurements refused as jumps
   uint64_t reinitialisations = 0;  // re-starts after reinit_after_gated gated in a row
   uint64_t predictions = 0;        // outputs predicted without a measurement
+  uint64_t too_uncertain = 0;      // of those, withheld as past coast_max_sd_m / _yaw_sd_rad
   uint64_t timeouts = 0;           // times the filter gave up after predict_timeout_ms
   uint64_t close_restarts = 0;     // re-starts on a frame within min_frame_interval_ms
 };
@@ -32,7 +33,9 @@ class TemporalFilter {
   // `timestamp_ns` (monotonic), at the instant the estimate refers to
   // (timestamp_ns + its time_offset_s), and returns the filtered pose at
   // timestamp_ns; invalid until a first valid measurement and again once
-  // predict_timeout_ms passes without one. An instant earlier than the
+  // predict_timeout_ms passes without one; a prediction without a fused
+  // measurement is invalid (the state carries on) once its sd passes
+  // coast_max_sd_m or coast_max_yaw_sd_rad. An instant earlier than the
   // previous one is treated as the same instant. A valid measurement of a
   // frame stamped within min_frame_interval_ms of the last one fused (or
   // earlier) restarts the filter on itself.
@@ -57,6 +60,9 @@ class TemporalFilter {
   bool innovation(const PoseEstimate& m, std::array<double, 3>* y,
                   std::array<double, 9>* s_inv) const;
   bool gated(const std::array<double, 3>& y, const std::array<double, 9>& s_inv) const;
+  // The prediction to frame_ns without a measurement, invalid past the
+  // coasting bounds.
+  PoseEstimate coast(int64_t frame_ns);
   void correct(const std::array<double, 3>& y, const std::array<double, 9>& s_inv);
   PoseEstimate output(const PoseEstimate* used, int64_t timestamp_ns) const;
 

@@ -11,11 +11,13 @@ namespace {
 
 constexpr int64_t kFrameNs = 33'333'333;  // 30 fps
 
-PoseEstimate measurement(double x, double y, double yaw, double sigma_m = 0.005) {
+PoseEstimate measurement(double x, double y, double yaw, double sigma_m = 0.005,
+                         double sigma_yaw_rad = 0.01) {
   PoseEstimate m;
   m.valid = true;
   m.pose = {x, y, yaw};
-  m.covariance = {sigma_m * sigma_m, 0, 0, 0, sigma_m * sigma_m, 0, 0, 0, 0.01 * 0.01};
+  m.covariance = {
+      sigma_m * sigma_m, 0, 0, 0, sigma_m * sigma_m, 0, 0, 0, sigma_yaw_rad * sigma_yaw_rad};
   m.mode = PositioningMode::kLeastSquares;
   m.markers = 9;
   return m;
@@ -129,8 +131,17 @@ TEST(TemporalFilter, WrapsYawAcrossPi) {
   EXPECT_EQ(filter.stats().gated, 0u);
 }
 
+// A gated frame publishes the prediction (within the coasting bounds; these
+// measurements' 0.01 rad yaw sd leaves a prediction's at 0.061 rad, past
+// them, so the bounds are lifted here: the gate alone).
+FilterParams gate_alone() {
+  FilterParams params;
+  params.coast_max_sd_m = params.coast_max_yaw_sd_rad = 1e9;
+  return params;
+}
+
 TEST(TemporalFilter, GatesASingleJump) {
-  TemporalFilter filter{FilterParams{}};
+  TemporalFilter filter{gate_alone()};
   for (int k = 0; k < 30; ++k) filter.update(measurement(1.0, 1.0, 0.0), k * kFrameNs);
   const PoseEstimate out = filter.update(measurement(1.6, 1.0, 0.0), 30 * kFrameNs);
   ASSERT_TRUE(out.valid);
@@ -140,7 +151,7 @@ TEST(TemporalFilter, GatesASingleJump) {
 }
 
 TEST(TemporalFilter, ReinitialisesAfterConsecutiveGatedMeasurements) {
-  FilterParams params;
+  FilterParams params = gate_alone();
   params.reinit_after_gated = 4;
   TemporalFilter filter{params};
   for (int k = 0; k < 30; ++k) filter.update(measurement(1.0, 1.0, 0.0), k * kFrameNs);
@@ -156,7 +167,7 @@ TEST(TemporalFilter, ReinitialisesAfterConsecutiveGatedMeasurements) {
 }
 
 TEST(TemporalFilter, PredictsThroughMissingFramesThenTimesOut) {
-  FilterParams params;
+  FilterParams params = gate_alone();  // the timeout alone
   params.predict_timeout_ms = 200.0;
   TemporalFilter filter{params};
   for (int k = 0; k < 60; ++k) {
@@ -174,6 +185,42 @@ TEST(TemporalFilter, PredictsThroughMissingFramesThenTimesOut) {
   out = filter.update(PoseEstimate{}, 59 * kFrameNs + 250'000'000);
   EXPECT_FALSE(out.valid);
   EXPECT_EQ(filter.stats().timeouts, 1u);
+}
+
+// Without measurements the prediction's yaw sd grows fast (the yaw jerk
+// noise is sized for sudden turns): it is reported while SPEC §6's gross
+// error (5°, 0.25 grid units) lies beyond two of its sds, then withheld,
+// while the state carries on and fuses the next measurement without a
+// restart. Measurements as positioning gives them (0.2 mm, 0.001 rad).
+TEST(TemporalFilter, APredictionIsWithheldOnceAGrossErrorIsWithinTwoSds) {
+  const FilterParams params;
+  TemporalFilter filter{params};
+  const double turn_radps = 1.0;
+  auto yaw_at = [&](int k) { return turn_radps * k * kFrameNs * 1e-9; };
+  auto measured = [&](int k) { return measurement(1.0, 1.0, yaw_at(k), 0.0002, 0.001); };
+  for (int k = 0; k < 60; ++k) filter.update(measured(k), k * kFrameNs);
+  const PoseEstimate one = filter.update(PoseEstimate{}, 60 * kFrameNs);
+  ASSERT_TRUE(one.valid) << "one frame on: yaw sd " << std::sqrt(one.covariance[8]);
+  EXPECT_LE(std::sqrt(one.covariance[8]), params.coast_max_yaw_sd_rad);
+  EXPECT_LE(std::sqrt(one.covariance[0]), params.coast_max_sd_m);
+  EXPECT_NEAR(one.pose.yaw_rad, yaw_at(60), 0.01);
+  int withheld_from = -1;
+  for (int k = 61; k < 66; ++k) {
+    const PoseEstimate out = filter.update(PoseEstimate{}, k * kFrameNs);
+    if (!out.valid && withheld_from < 0) withheld_from = k;
+    if (withheld_from >= 0) {
+      EXPECT_FALSE(out.valid) << "once withheld, withheld: frame " << k;
+    }
+  }
+  ASSERT_GE(withheld_from, 61) << "withheld within 6 frames of coasting";
+  EXPECT_EQ(filter.stats().predictions, 6u);
+  EXPECT_EQ(filter.stats().too_uncertain, static_cast<uint64_t>(66 - withheld_from));
+  EXPECT_EQ(filter.stats().timeouts, 0u);
+  const PoseEstimate back = filter.update(measured(66), 66 * kFrameNs);
+  ASSERT_TRUE(back.valid);
+  EXPECT_NEAR(back.pose.yaw_rad, yaw_at(66), 0.002);
+  EXPECT_EQ(filter.stats().reinitialisations, 0u) << "fused, not restarted";
+  EXPECT_EQ(filter.stats().updates, 61u);
 }
 
 TEST(TemporalFilter, ResetForgetsTheTrack) {
