@@ -59,4 +59,26 @@ bool solve_spd(const std::array<double, N * N>& a, const std::array<bool, N>& ac
   return true;
 }
 
+// Inverse of a symmetric 3x3 matrix; false when singular.
+inline bool invert3(const std::array<double, 9>& m, std::array<double, 9>* inv) {
+  const double c00 = m[4] * m[8] - m[5] * m[7];
+  const double c01 = m[5] * m[6] - m[3] * m[8];
+  const double c02 = m[3] * m[7] - m[4] * m[6];
+  const double det = m[0] * c00 + m[1] * c01 + m[2] * c02;
+  if (!(std::abs(det) > 1e-300)) return false;
+  const double id = 1.0 / det;
+  *inv = {c00 * id, (m[2] * m[7] - m[1] * m[8]) * id, (m[1] * m[5] - m[2] * m[4]) * id,
+          c01 * id, (m[0] * m[8] - m[2] * m[6]) * id, (m[2] * m[3] - m[0] * m[5]) * id,
+          c02 * id, (m[1] * m[6] - m[0] * m[7]) * id, (m[0] * m[4] - m[1] * m[3]) * id};
+  return true;
+}
+
+// y^T m y for a 3x3 m (row-major).
+inline double quadratic_form3(const std::array<double, 9>& m, const std::array<double, 3>& y) {
+  double sum = 0.0;
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j) sum += y[i] * m[i * 3 + j] * y[j];
+  return sum;
+}
+
 }  // namespace ceilpose

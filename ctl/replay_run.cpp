@@ -131,6 +131,7 @@ int run_replay(const ReplayArgs& args, const char* command, const ReplaySetup& s
                std::span<PoseSink* const> sinks) {
   const RecordingReader& reader = *setup.reader;
   Localizer localizer(setup.config);
+  localizer.defer_scheduled_sweeps(true);  // as the daemon does
   FramePrefetcher frames(reader, args.decode_threads);
   if (frames.threads() < args.decode_threads) {
     const CameraIntrinsics& k = reader.camera().intrinsics;
@@ -159,6 +160,7 @@ int run_replay(const ReplayArgs& args, const char* command, const ReplaySetup& s
     const Localization& loc = localizer.localize((*loaded)->view(), info);
     heights.consume(loc);
     for (PoseSink* sink : sinks) sink->consume(loc);
+    localizer.check_scheduled((*loaded)->view());
     if (tty && (i % 25 == 0 || i + 1 == total)) {
       std::fprintf(stderr, "\r%s: frame %zu/%zu", command, i + 1, total);
       if (i + 1 == total) std::fputc('\n', stderr);

@@ -27,7 +27,10 @@ PipelineWorker::PipelineWorker(const ServiceConfig& config, WorkerOptions option
       progress_(progress),
       localizer_(config.pipeline),
       next_status_ns_(sinks.size(), 0),
-      fix_lost_after_ns_(int64_t{config.ipc.stale_after_ms} * 1'000'000) {}
+      fix_lost_after_ns_(int64_t{config.ipc.stale_after_ms} * 1'000'000) {
+  // Frame ready -> pose published without the scheduled whole sweep (process).
+  localizer_.defer_scheduled_sweeps(true);
+}
 
 PipelineWorker::~PipelineWorker() { stop(); }
 
@@ -122,8 +125,12 @@ void PipelineWorker::process(const capture::Frame& frame) {
   last_.latency_ns = stamps.published_ns - stamps.dequeue_ns;
   last_.fix = loc.fix;
   last_.fps = fps_;
-  std::unique_lock lock(snapshot_mutex_, std::try_to_lock);
-  if (lock.owns_lock()) snapshot_ = last_;
+  {
+    std::unique_lock lock(snapshot_mutex_, std::try_to_lock);
+    if (lock.owns_lock()) snapshot_ = last_;
+  }
+  // The scheduled whole sweep, now that the pose is out.
+  localizer_.check_scheduled(frame.image);
 }
 
 void PipelineWorker::update_fps(int64_t now_ns) {

@@ -5,6 +5,7 @@
 
 #include "core/clock.h"
 #include "core/finite.h"
+#include "core/small_matrix.h"
 #include "pipeline/camera_motion.h"
 
 namespace ceilpose {
@@ -30,6 +31,23 @@ bool halved_sweeps(const Pipeline& pipeline) {
          !positions_from_centroids(c.positioning.mode) && pipeline.halved_sweep_suits();
 }
 
+// The scheduled check (Localizer::check_scheduled): the tracked pose is
+// dropped when the whole sweep of the same frame gives none, or one the
+// filter would refuse as a jump from it. Their errors are correlated (the
+// same pixels, the same map), so the sum of their covariances overstates
+// the difference's: a test for a track gone wrong, not for noise (on the
+// unseen drives the two differ by chi-square 0.006-0.43, under 0.03 mm).
+bool scheduled_check_agrees(const FilterParams& params, const PoseEstimate& tracked,
+                            const PoseEstimate& whole) {
+  if (!tracked.valid || !whole.valid) return false;
+  const std::array<double, 3> d = {whole.pose.x_m - tracked.pose.x_m,
+                                   whole.pose.y_m - tracked.pose.y_m,
+                                   wrap_angle_rad(whole.pose.yaw_rad - tracked.pose.yaw_rad)};
+  std::array<double, 9> s{}, s_inv{};
+  for (size_t k = 0; k < s.size(); ++k) s[k] = tracked.covariance[k] + whole.covariance[k];
+  return invert3(s, &s_inv) && !is_jump(params, d, s_inv);
+}
+
 }  // namespace
 
 PipelineConfig with_mode(PipelineConfig config, PositioningMode mode, bool filter) {
@@ -44,6 +62,7 @@ Localizer::Localizer(const PipelineConfig& config)
       view_(config),
       decoded_last_(static_cast<size_t>(view_.map().codes()) * view_.map().codes(), 0),
       result_(std::make_unique<FrameResult>()),
+      check_result_(std::make_unique<FrameResult>()),
       halved_sweeps_(halved_sweeps(pipeline_)),
       planned_mount_(config.mount) {}
 
@@ -67,6 +86,7 @@ void Localizer::reconfigure(const PipelineConfig& config, bool reset_filter) {
 
 const Localization& Localizer::localize(const ImageView& image, const FrameInfo& frame) {
   const int64_t start_ns = monotonic_ns();
+  check_due_ = false;  // the last frame's, if its caller did not run it
   // 1. The frame on its own.
   const PipelineConfig& config = pipeline_.config();
   const bool filter = config.filter.enabled;
@@ -86,35 +106,19 @@ const Localization& Localizer::localize(const ImageView& image, const FrameInfo&
     if (plan_.edges) {
       pipeline_.process_tracked(image, config.positioning.mode, result_.get(), motion,
                                 plan_.predicted_span());
-      decode_whole = edges_alone_freed_tilt();
+      decode_whole = edges_alone_freed_tilt(*result_);
     } else {
       pipeline_.process(image, config.positioning.mode, result_.get(), motion, plan_.span());
-      remember_tilt_decision();
+      remember_tilt_decision(*result_);
     }
     out_.swept_px = result_->swept_px;
     if (decode_whole || !tracked_sweep_held()) sweep = FullSweepReason::kTrackFailed;
   }
   if (sweep != FullSweepReason::kNone) {
-    // A halved sweep stands when it gave a pose and measured at least two
-    // thirds of the pairs it found uncut. Under the stress levels, 1 frame
-    // of 16 had most of its markers blurred past their edges' profiles (2
-    // measured, 7 refused), which a full sweep's decode reads; a wide angle
-    // lens refuses 3-4 of 12 at its corners either way. Nor when its
-    // edges alone freed the tilt (edges_alone_freed_tilt).
-    if (halved_sweeps_ && !decode_whole) {
-      pipeline_.process_halved(image, config.positioning.mode, result_.get(), motion);
-      out_.swept_px += result_->swept_px;
-      const MarkerRejects& r = result_->rejects;
-      out_.halved = result_->estimate.valid && result_->marker_count >= 2 * (r.total() - r.cut) &&
-                    !edges_alone_freed_tilt();
-    }
-    if (!out_.halved) {
-      pipeline_.process(image, config.positioning.mode, result_.get(), motion);
-      out_.swept_px += result_->swept_px;
-      remember_tilt_decision();
-    }
+    out_.halved = sweep_whole(image, motion, decode_whole, result_.get(), &out_.swept_px);
     sweeps_.halved += out_.halved ? 1 : 0;
     frames_since_full_ = 0;
+    check_due_ = false;
   } else {
     ++frames_since_full_;
   }
@@ -252,7 +256,10 @@ FullSweepReason Localizer::plan_sweep() {
   if (!fix) prediction_errors_.reset();
   if (!c.detector.tracking || !c.filter.enabled) return FullSweepReason::kOff;
   if (!fix) return FullSweepReason::kNoFix;
-  if (frames_since_full_ + 1 >= c.detector.full_sweep_every) return FullSweepReason::kScheduled;
+  if (frames_since_full_ + 1 >= c.detector.full_sweep_every) {
+    if (!defer_scheduled_) return FullSweepReason::kScheduled;
+    check_due_ = true;  // tracked now, swept whole once published
+  }
   const bool extrapolation_better = has_extrapolation_ && extrapolation_errors_.known() &&
                                     prediction_errors_.known() &&
                                     prediction_error_px(view_, extrapolation_errors_) <
@@ -263,6 +270,48 @@ FullSweepReason Localizer::plan_sweep() {
   }
   return plan_tracking(view_, planned_mount_, c.detector, c.positioning.mode, predicted_,
                        prediction_errors_, &plan_);
+}
+
+// A halved sweep stands when it gave a pose and measured at least two
+// thirds of the pairs it found uncut. Under the stress levels, 1 frame of
+// 16 had most of its markers blurred past their edges' profiles (2
+// measured, 7 refused), which a full sweep's decode reads; a wide angle
+// lens refuses 3-4 of 12 at its corners either way. Nor when its edges
+// alone freed the tilt (edges_alone_freed_tilt).
+bool Localizer::sweep_whole(const ImageView& image, const CameraMotion& motion, bool decode_whole,
+                            FrameResult* r, int64_t* swept_px) {
+  const PositioningMode mode = pipeline_.config().positioning.mode;
+  bool halved = false;
+  if (halved_sweeps_ && !decode_whole) {
+    pipeline_.process_halved(image, mode, r, motion);
+    *swept_px += r->swept_px;
+    const MarkerRejects& rejects = r->rejects;
+    halved = r->estimate.valid && r->marker_count >= 2 * (rejects.total() - rejects.cut) &&
+             !edges_alone_freed_tilt(*r);
+  }
+  if (!halved) {
+    pipeline_.process(image, mode, r, motion);
+    *swept_px += r->swept_px;
+    remember_tilt_decision(*r);
+  }
+  return halved;
+}
+
+void Localizer::check_scheduled(const ImageView& image) {
+  if (!check_due_) return;
+  check_due_ = false;
+  frames_since_full_ = 0;
+  int64_t swept_px = 0;
+  sweep_whole(image, readout_motion(), false, check_result_.get(), &swept_px);
+  ++sweeps_.checked;
+  if (scheduled_check_agrees(pipeline_.config().filter, out_.measured, check_result_->estimate))
+    return;
+  ++sweeps_.check_failed;
+  filter_.reset();
+  prediction_errors_.reset();
+  extrapolation_errors_.reset();
+  measured_count_ = 0;
+  last_measured_ = false;
 }
 
 // A tracked sweep stands only when it decoded again every marker the last
@@ -293,19 +342,18 @@ bool Localizer::tracked_sweep_held() const {
 // 0.9-9.6. Such a frame is decoded whole, whose decision stands; once a
 // whole decode has freed the tilt (a mount tilted past its calibration),
 // edge points free it again on their own.
-bool Localizer::edges_alone_freed_tilt() const {
-  const LsqResult* fit = last_fit();
+bool Localizer::edges_alone_freed_tilt(const FrameResult& r) const {
+  const LsqResult* fit = last_fit(r);
   return !decode_freed_tilt_ && fit != nullptr && fit->tilt_choice == TiltChoice::kFreeFits;
 }
 
-void Localizer::remember_tilt_decision() {
-  const LsqResult* fit = last_fit();
+void Localizer::remember_tilt_decision(const FrameResult& r) {
+  const LsqResult* fit = last_fit(r);
   if (fit != nullptr && fit->tilt_choice != TiltChoice::kNotAllowed)
     decode_freed_tilt_ = fit->tilt_choice == TiltChoice::kFreeFits;
 }
 
-const LsqResult* Localizer::last_fit() const {
-  const FrameResult& r = *result_;
+const LsqResult* Localizer::last_fit(const FrameResult& r) const {
   if (!r.estimate.valid || r.estimate.mode != PositioningMode::kLeastSquares) return nullptr;
   return &pipeline_.positioner().last_lsq();
 }
@@ -313,7 +361,7 @@ const LsqResult* Localizer::last_fit() const {
 // The pose the filter carries was fitted with this tilt: predicted with
 // it, the markers fall where that fit saw them.
 void Localizer::remember_fitted_tilt() {
-  const LsqResult* fit = last_fit();
+  const LsqResult* fit = last_fit(*result_);
   if (fit == nullptr) return;
   const CameraMount& configured = pipeline_.config().mount;
   const bool freed = fit->tilt_estimated && std::isfinite(fit->tilt_x_rad + fit->tilt_y_rad);

@@ -23,6 +23,10 @@ namespace ceilpose {
 struct SweepCounts {
   std::array<uint64_t, 7> by_reason{};  // index: FullSweepReason
   uint64_t halved = 0;                  // of the whole ones: found at half resolution
+  // Scheduled whole sweeps run after publishing (Localizer::check_scheduled),
+  // and of those, how many disagreed with the tracked pose of their frame.
+  uint64_t checked = 0;
+  uint64_t check_failed = 0;
   uint64_t tracked() const { return by_reason[0]; }
   uint64_t full() const {
     uint64_t n = 0;
@@ -44,6 +48,22 @@ class Localizer {
   // Localizes one frame taken at frame.timestamp_ns (monotonic order). The
   // result stays valid until the next call.
   const Localization& localize(const ImageView& image, const FrameInfo& frame);
+
+  // The scheduled whole sweep (detector.full_sweep_every) after publishing:
+  // with this on, a frame due for it is tracked like any other, and
+  // check_due() says the caller should call check_scheduled() with the same
+  // image once the pose is out (the daemon, `locate`). Off, the scheduled
+  // frame is swept whole before its pose (the tests, the benchmarks).
+  void defer_scheduled_sweeps(bool on) { defer_scheduled_ = on; }
+  bool check_due() const { return check_due_; }
+  // Sweeps the last frame whole (`image` must be the one localize() was
+  // given) and compares its pose with the tracked one. When the whole sweep
+  // gives no pose, or one the filter would refuse as a jump from the
+  // tracked one (is_jump), the fix is dropped: the filter restarts and
+  // the next frame is swept whole. The last Localization's figures stay as
+  // they were; its `detection` (the pipeline's state) then shows this sweep,
+  // so a caller reads it before.
+  void check_scheduled(const ImageView& image);
 
   // Between frames (SIGHUP): new tuning, mode and filter switch; the filter's
   // state is kept unless `reset_filter`.
@@ -91,7 +111,10 @@ class Localizer {
   int frames_since_full_ = 0;
   bool last_measured_ = false;  // the previous frame gave a measurement
   SweepCounts sweeps_;
-  std::unique_ptr<FrameResult> result_;  // ~50 kB: on the heap, allocated once
+  std::unique_ptr<FrameResult> result_;        // ~50 kB: on the heap, allocated once
+  std::unique_ptr<FrameResult> check_result_;  // the scheduled check's, likewise
+  bool defer_scheduled_ = false;
+  bool check_due_ = false;
   Localization out_;
   bool had_fix_ = false;
   // Frames swept whole are found at half resolution first
@@ -116,16 +139,21 @@ class Localizer {
   CameraMotion readout_motion() const;
   // Windows for this frame (plan_), or why to sweep it whole.
   FullSweepReason plan_sweep();
+  // Sweeps the frame whole into *r: at half resolution first where that
+  // suits, then at full resolution unless the halved sweep stood. Returns
+  // whether it stood; adds the pixels swept to *swept_px.
+  bool sweep_whole(const ImageView& image, const CameraMotion& motion, bool decode_whole,
+                   FrameResult* r, int64_t* swept_px);
   // Whether a tracked sweep found what the plan expected.
   bool tracked_sweep_held() const;
   // The last sweep measured edge points alone and freed the tilt on them,
   // which no whole decode has confirmed.
-  bool edges_alone_freed_tilt() const;
+  bool edges_alone_freed_tilt(const FrameResult& r) const;
   // After a whole decode: the tilt decision it made, if any.
-  void remember_tilt_decision();
-  // This frame's least-squares fit; null when the frame gave no pose or was
-  // positioned another way.
-  const LsqResult* last_fit() const;
+  void remember_tilt_decision(const FrameResult& r);
+  // The least-squares fit that gave r; null when r gave no pose or was
+  // positioned another way. Only for the pipeline's last sweep.
+  const LsqResult* last_fit(const FrameResult& r) const;
 };
 
 }  // namespace ceilpose

@@ -3,25 +3,9 @@
 #include <algorithm>
 #include <cmath>
 
+#include "core/small_matrix.h"
+
 namespace ceilpose {
-namespace {
-
-// Inverse of a symmetric 3x3 matrix; false when singular.
-bool invert3(const std::array<double, 9>& m, std::array<double, 9>* inv) {
-  const double c00 = m[4] * m[8] - m[5] * m[7];
-  const double c01 = m[5] * m[6] - m[3] * m[8];
-  const double c02 = m[3] * m[7] - m[4] * m[6];
-  const double det = m[0] * c00 + m[1] * c01 + m[2] * c02;
-  if (!(std::abs(det) > 1e-300)) return false;
-  const double id = 1.0 / det;
-  *inv = {c00 * id, (m[2] * m[7] - m[1] * m[8]) * id, (m[1] * m[5] - m[2] * m[4]) * id,
-          c01 * id, (m[0] * m[8] - m[2] * m[6]) * id, (m[2] * m[3] - m[0] * m[5]) * id,
-          c02 * id, (m[1] * m[6] - m[0] * m[7]) * id, (m[0] * m[4] - m[1] * m[3]) * id};
-  return true;
-}
-
-}  // namespace
-
 TemporalFilter::TemporalFilter(const FilterParams& params) : params_(params) {}
 
 void TemporalFilter::reset() {
@@ -116,16 +100,12 @@ bool TemporalFilter::innovation(const PoseEstimate& m, std::array<double, 3>* y,
   return invert3(s, s_inv);
 }
 
-// Whether the innovation is a jump to refuse: beyond the chi-square gate and
-// not within the small-innovation allowance.
-bool TemporalFilter::gated(const std::array<double, 3>& y,
-                           const std::array<double, 9>& s_inv) const {
-  double d2 = 0.0;
-  for (int i = 0; i < 3; ++i)
-    for (int j = 0; j < 3; ++j) d2 += y[i] * s_inv[i * 3 + j] * y[j];
+bool is_jump(const FilterParams& params, const std::array<double, 3>& y,
+             const std::array<double, 9>& s_inv) {
+  const double d2 = quadratic_form3(s_inv, y);
   const bool small =
-      std::hypot(y[0], y[1]) <= params_.gate_min_m && std::abs(y[2]) <= params_.gate_min_rad;
-  return d2 > params_.gate_chi2 && !small;
+      std::hypot(y[0], y[1]) <= params.gate_min_m && std::abs(y[2]) <= params.gate_min_rad;
+  return d2 > params.gate_chi2 && !small;
 }
 
 // K = P H^T S^-1 (9x3); x += K y; P -= K H P, kept symmetric.
@@ -191,7 +171,7 @@ PoseEstimate TemporalFilter::update(const PoseEstimate& m, int64_t frame_ns) {
   if (!m.valid || !innovation(m, &y, &s_inv)) {
     return coast(frame_ns);
   }
-  if (gated(y, s_inv)) {
+  if (is_jump(params_, y, s_inv)) {
     ++stats_.gated;
     if (++consecutive_gated_ >= params_.reinit_after_gated) {
       // The measurements have agreed with each other, not with us, for long

@@ -25,6 +25,14 @@ struct FilterStats {
 
 // Not thread-safe: one instance, called from the pipeline thread in frame
 // order. update() allocates nothing and throws nothing.
+// Whether the difference y between two poses (x_m, y_m, yaw_rad), with
+// s_inv the inverse of its covariance, is a jump: beyond the chi-square gate
+// (FilterParams::gate_chi2) and not within the small-difference allowance
+// (gate_min_m, gate_min_rad). The filter refuses such a measurement; the
+// localizer's scheduled check drops a track whose whole sweep differs so.
+bool is_jump(const FilterParams& params, const std::array<double, 3>& y,
+             const std::array<double, 9>& s_inv);
+
 class TemporalFilter {
  public:
   explicit TemporalFilter(const FilterParams& params);
@@ -59,7 +67,6 @@ class TemporalFilter {
   void predict(double dt_s);
   bool innovation(const PoseEstimate& m, std::array<double, 3>* y,
                   std::array<double, 9>* s_inv) const;
-  bool gated(const std::array<double, 3>& y, const std::array<double, 9>& s_inv) const;
   // The prediction to frame_ns without a measurement, invalid past the
   // coasting bounds.
   PoseEstimate coast(int64_t frame_ns);

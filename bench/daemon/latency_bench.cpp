@@ -184,6 +184,9 @@ void BM_FrameToPose(benchmark::State& state, bool replay) {
     state.counters["whole_share"] = static_cast<double>(sweeps.full()) / swept;
     state.counters["uncertain_share"] = share(FullSweepReason::kUncertain);
     state.counters["scheduled_share"] = share(FullSweepReason::kScheduled);
+    // Scheduled whole sweeps run after the pose (Localizer::check_scheduled).
+    state.counters["checked_share"] = static_cast<double>(sweeps.checked) / swept;
+    state.counters["check_failed"] = static_cast<double>(sweeps.check_failed);
     const double lost_first = static_cast<double>(half.skipped + half.drops);
     const double lost_all = static_cast<double>(end.skipped + end.drops);
     state.counters["skipped"] = lost_all;
