@@ -34,8 +34,18 @@ PipelineWorker::PipelineWorker(const ServiceConfig& config, WorkerOptions option
 
 PipelineWorker::~PipelineWorker() { stop(); }
 
+int64_t PipelineWorker::thread_cpu_ns() const {
+  clockid_t clock{};
+  timespec ts{};
+  if (!thread_.joinable() || pthread_getcpuclockid(native_thread_, &clock) != 0 ||
+      clock_gettime(clock, &ts) != 0)
+    return 0;
+  return int64_t{ts.tv_sec} * 1'000'000'000 + ts.tv_nsec;
+}
+
 void PipelineWorker::start() {
   thread_ = std::thread([this] { run(); });
+  native_thread_ = thread_.native_handle();
   pthread_setname_np(thread_.native_handle(), "ceilpose-pipe");
   if (options_.rt_priority > 0) {
     // From here rather than the thread itself so that the result is known

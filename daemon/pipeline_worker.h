@@ -11,6 +11,8 @@
 //
 // Threads: constructor, start(), stop(), reload() and the accessors from the
 // control thread; everything else runs on the worker's own thread.
+#include <pthread.h>
+
 #include <atomic>
 #include <cstdint>
 #include <memory>
@@ -67,6 +69,9 @@ class PipelineWorker {
   void start();
   // Asks the thread to finish its frame and joins it.
   void stop();
+  // CPU time the thread has used, nanoseconds (0 unless it runs); called
+  // from the thread that starts and stops it.
+  int64_t thread_cpu_ns() const;
 
   // Hands the live part of `config` (pipeline tuning, positioning mode,
   // filter) to the thread, which applies it between two frames.
@@ -117,6 +122,7 @@ class PipelineWorker {
   std::atomic<bool> finished_{false};
   std::atomic<bool> realtime_{false};
   std::thread thread_;
+  pthread_t native_thread_{};  // thread_'s, for its CPU clock from other threads
 
   mutable std::mutex snapshot_mutex_;  // writer only try_locks: never waits
   PoseSnapshot snapshot_;

@@ -149,11 +149,16 @@ void BM_FrameToPose(benchmark::State& state, bool replay) {
     if (loaded) busy = std::make_unique<BusyCore>(1);
     const auto t0 = std::chrono::steady_clock::now();
     worker.start();
+    const int64_t cpu_start_ns = worker.thread_cpu_ns(), wall_start_ns = monotonic_ns();
     // Backlog growth: skipped + dropped over the second half of the run
     // against the first half.
     std::this_thread::sleep_for(std::chrono::duration<double>(g_duration_s / 2));
     const capture::CaptureStats half = capture.stats();
     std::this_thread::sleep_for(std::chrono::duration<double>(g_duration_s / 2));
+    // The pipeline thread's share of a core.
+    state.counters["pipe_cpu_pct"] =
+        100.0 * static_cast<double>(worker.thread_cpu_ns() - cpu_start_ns) /
+        static_cast<double>(std::max<int64_t>(1, monotonic_ns() - wall_start_ns));
     worker.stop();
     capture.stop();
     busy.reset();

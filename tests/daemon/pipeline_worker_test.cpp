@@ -83,6 +83,22 @@ TEST(PipelineWorker, PublishesEveryProcessedFrameAndCountsProgress) {
   EXPECT_FALSE(worker.finished()) << "stopped on request, not by the source";
 }
 
+// latency_bench's pipe_cpu_pct: the thread's own CPU clock, read from
+// another thread while it runs.
+TEST(PipelineWorker, ReportsItsThreadsCpuTimeWhileItRuns) {
+  Rig rig;
+  PipelineWorker worker(rig.config, WorkerOptions{}, rig.capture.get(), rig.sinks, &rig.progress);
+  EXPECT_EQ(worker.thread_cpu_ns(), 0) << "no thread yet";
+  worker.start();
+  ASSERT_TRUE(wait_frames(worker, 3));
+  const int64_t first_ns = worker.thread_cpu_ns();
+  EXPECT_GT(first_ns, 0) << "three frames localized cost no CPU";
+  ASSERT_TRUE(wait_frames(worker, worker.frames() + 3));
+  EXPECT_GE(worker.thread_cpu_ns(), first_ns);
+  worker.stop();
+  EXPECT_EQ(worker.thread_cpu_ns(), 0) << "a joined thread's clock read";
+}
+
 TEST(PipelineWorker, SnapshotsAndReloadsFromAnotherThreadKeepTheSequenceRising) {
   Rig rig;
   PipelineWorker worker(rig.config, WorkerOptions{}, rig.capture.get(), rig.sinks, &rig.progress);
