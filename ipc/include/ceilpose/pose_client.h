@@ -124,8 +124,10 @@ typedef struct ceilpose_status {
    * the reason ceilpose_refusal_name(i) ("none": frames that gave a pose);
    * the first refusal_count slots are used. */
   uint32_t refusal_count;
-  /* Frames swept whole (no fix, scheduled, or a failed track swept again),
-   * since the daemon started, modulo 2^32; 0 from daemons before it. */
+  /* Frames swept whole before their pose (no fix, an uncertain prediction,
+   * or a failed track swept again), since the daemon started, modulo 2^32;
+   * 0 from daemons before it. The scheduled whole sweep runs after its
+   * frame's tracked pose, as a check, and is not counted here. */
   uint32_t full_sweep_frames;
   uint64_t refusals[CEILPOSE_REFUSAL_SLOTS];
 } ceilpose_status;
