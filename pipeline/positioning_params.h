@@ -158,7 +158,9 @@ struct FilterParams {
   double meas_sigma_floor_m = 0.0002;
   double meas_sigma_floor_yaw_rad = 0.0005;
   // Gate on the squared Mahalanobis distance of the innovation (3 DOF).
-  // 16.3 is the 99.9% point of chi²(3); raise to accept faster motion.
+  // 16.3 is the 99.9% point of chi²(3); raise to accept faster motion. A
+  // gated frame publishes no pose: neither the measurement nor the
+  // prediction it contradicts.
   double gate_chi2 = 16.3;
   // Innovations smaller than these are never gated (metres / radians), so a
   // very confident filter does not lock out a slightly-off good measurement.

@@ -181,7 +181,11 @@ PoseEstimate TemporalFilter::update(const PoseEstimate& m, int64_t frame_ns) {
       last_frame_ns_ = frame_ns;
       return output(&m, frame_ns);
     }
-    return coast(frame_ns);
+    // The measurement and the prediction disagree beyond the gate: one of
+    // them is grossly wrong and nothing here says which (a decode gone
+    // wrong, or a robot picked up and set down, or moving faster than the
+    // model allows), so neither is published (docs/decisions.md).
+    return PoseEstimate{};
   }
   correct(y, s_inv);
   consecutive_gated_ = 0;

@@ -15,7 +15,7 @@ namespace ceilpose {
 
 struct FilterStats {
   uint64_t updates = 0;            // measurements fused
-  uint64_t gated = 0;              // measurements refused as jumps
+  uint64_t gated = 0;              // measurements refused as jumps (no pose published)
   uint64_t reinitialisations = 0;  // re-starts after reinit_after_gated gated in a row
   uint64_t predictions = 0;        // outputs predicted without a measurement
   uint64_t too_uncertain = 0;      // of those, withheld as past coast_max_sd_m / _yaw_sd_rad

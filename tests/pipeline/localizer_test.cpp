@@ -141,8 +141,10 @@ TEST_F(LocalizerTest, LocalizeWithFilterAndRollingShutterAllocatesNothing) {
   PipelineConfig config = with_mode(config_, PositioningMode::kAuto, true);
   config.intrinsics.readout_ms = 25.0;
   // The alternating poses leave the prediction's yaw sd past the coasting
-  // bound: lifted, so that the black frame's published prediction is timed.
+  // bound, and jump back and forth as no robot does, which the gate would
+  // refuse: both lifted, so that every frame's published pose is timed.
   config.filter.coast_max_sd_m = config.filter.coast_max_yaw_sd_rad = 1e9;
+  config.filter.gate_chi2 = 1e9;
   Localizer localizer(config);
   const Image a = frame_at({2.0, 2.0, 0.4}), b = frame_at({2.02, 2.0, 0.41});
   for (int k = 0; k < 4; ++k) localizer.localize((k % 2 ? b : a).view(), next_frame());  // warm-up
