@@ -77,11 +77,17 @@ void Localizer::reconfigure(const PipelineConfig& config, bool reset_filter) {
   planned_mount_ = config.mount;
   if (reset_filter) {
     filter_ = TemporalFilter(config.filter);
-    prediction_errors_.reset();
-    measured_count_ = 0;
-    extrapolation_errors_.reset();
+    forget_motion();
     had_fix_ = false;
   }
+}
+
+void Localizer::forget_motion() {
+  filter_.reset();
+  prediction_errors_.reset();
+  extrapolation_errors_.reset();
+  measured_count_ = 0;
+  last_measured_ = false;
 }
 
 const Localization& Localizer::localize(const ImageView& image, const FrameInfo& frame) {
@@ -307,11 +313,7 @@ void Localizer::check_scheduled(const ImageView& image) {
   if (scheduled_check_agrees(pipeline_.config().filter, out_.measured, check_result_->estimate))
     return;
   ++sweeps_.check_failed;
-  filter_.reset();
-  prediction_errors_.reset();
-  extrapolation_errors_.reset();
-  measured_count_ = 0;
-  last_measured_ = false;
+  forget_motion();
 }
 
 // A tracked sweep stands only when it decoded again every marker the last

@@ -133,6 +133,9 @@ class Localizer {
   void remember_fitted_tilt();
   RefusalHistogram refusals_;
 
+  // The filter restarted, and the motion the tracking plan remembers
+  // (prediction errors, the last measurements) forgotten with it.
+  void forget_motion();
   // The filter's motion at this frame's time (predicted_) moved to the
   // optical centre, for a rolling shutter's readout; invalid when there is
   // no filter, no state within the prediction horizon or no readout.

@@ -23,8 +23,6 @@ struct FilterStats {
   uint64_t close_restarts = 0;     // re-starts on a frame within min_frame_interval_ms
 };
 
-// Not thread-safe: one instance, called from the pipeline thread in frame
-// order. update() allocates nothing and throws nothing.
 // Whether the difference y between two poses (x_m, y_m, yaw_rad), with
 // s_inv the inverse of its covariance, is a jump: beyond the chi-square gate
 // (FilterParams::gate_chi2) and not within the small-difference allowance
@@ -33,6 +31,8 @@ struct FilterStats {
 bool is_jump(const FilterParams& params, const std::array<double, 3>& y,
              const std::array<double, 9>& s_inv);
 
+// Not thread-safe: one instance, called from the pipeline thread in frame
+// order. update() allocates nothing and throws nothing.
 class TemporalFilter {
  public:
   explicit TemporalFilter(const FilterParams& params);
@@ -43,7 +43,9 @@ class TemporalFilter {
   // timestamp_ns; invalid until a first valid measurement and again once
   // predict_timeout_ms passes without one; a prediction without a fused
   // measurement is invalid (the state carries on) once its sd passes
-  // coast_max_sd_m or coast_max_yaw_sd_rad. An instant earlier than the
+  // coast_max_sd_m or coast_max_yaw_sd_rad; a frame whose measurement is a
+  // jump (is_jump) is invalid too, until reinit_after_gated in a row restart
+  // the filter on it. An instant earlier than the
   // previous one is treated as the same instant. A valid measurement of a
   // frame stamped within min_frame_interval_ms of the last one fused (or
   // earlier) restarts the filter on itself.
