@@ -105,7 +105,7 @@ constexpr double kDistinctViewPx = 1.0;
 // this (relative 1-sigma), or when the views left out of it are reprojected
 // worse than kMaxHeldOutPx and kMaxHeldOutRatio times the fit's RMS: it
 // fits the views it saw and not the camera.
-constexpr double kMaxFocalSigma = 0.01;
+constexpr double kMaxCheckerboardFocalSigma = 0.01;
 constexpr double kMaxHeldOutPx = 1.0;
 constexpr double kMaxHeldOutRatio = 3.0;
 // A view is flagged when left out it is reprojected this many times worse
@@ -302,11 +302,12 @@ void run_calibrate_camera(const CameraArgs& args) {
                out.distortion[2], out.distortion[3], out.distortion[4]);
   std::string refusal;
   char why[256];
-  if (!(sigma_fx <= kMaxFocalSigma * out.fx && sigma_fy <= kMaxFocalSigma * out.fy)) {
+  if (!(sigma_fx <= kMaxCheckerboardFocalSigma * out.fx &&
+        sigma_fy <= kMaxCheckerboardFocalSigma * out.fy)) {
     std::snprintf(why, sizeof why,
                   "the focal lengths are undetermined (1-sigma %.1f and %.1f px, over %.0f %%): "
                   "the views are too alike; tilt the board 20-45 deg in several directions",
-                  sigma_fx, sigma_fy, 100.0 * kMaxFocalSigma);
+                  sigma_fx, sigma_fy, 100.0 * kMaxCheckerboardFocalSigma);
     refusal = why;
   } else if (!std::isfinite(held_out_rms) ||
              (held_out_rms > kMaxHeldOutPx && held_out_rms > kMaxHeldOutRatio * rms)) {
@@ -479,7 +480,7 @@ void add_calibrate_command(CLI::App& app) {
   add_calibrate_robot_command(calibrate);
 }
 
-const CommandRegistrar kReg{"calibrate", &add_calibrate_command};
+const CommandRegistrar kCalibrateRegistrar{"calibrate", &add_calibrate_command};
 
 }  // namespace
 }  // namespace ceilpose::ctl

@@ -37,7 +37,7 @@ namespace {
 constexpr double kMaxFitRmsPx = 0.6;
 // Focal lengths known worse than this (relative 1-sigma) are not a
 // calibration.
-constexpr double kMaxFocalSigma = 0.002;
+constexpr double kMaxCeilingFocalSigma = 0.002;
 constexpr int kMaxDecodePasses = 4;
 // A principal point known no better than this was held by its prior about
 // the declared one (the lens distorts too little to show its centre).
@@ -164,8 +164,8 @@ void run_calibrate_robot(const RobotArgs& args) {
         "the camera model does not fit the drive: RMS reprojection error %.3f px (limit %.1f "
         "px): a lens needing p1, p2 or k3, or a map of another ceiling",
         r.rms_px, kMaxFitRmsPx);
-  else if (!(r.sigma_intrinsics[0] <= kMaxFocalSigma * k.fx &&
-             r.sigma_intrinsics[1] <= kMaxFocalSigma * k.fy))
+  else if (!(r.sigma_intrinsics[0] <= kMaxCeilingFocalSigma * k.fx &&
+             r.sigma_intrinsics[1] <= kMaxCeilingFocalSigma * k.fy))
     refusal = refusal_figures(
         "the drive does not determine the focal lengths: 1-sigma %.2f and %.2f px: drive "
         "under more of the ceiling",

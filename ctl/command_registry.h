@@ -1,6 +1,8 @@
 #pragma once
 // Sub-commands of ceilposectl register themselves here from their own file:
-//   static const CommandRegistrar kReg{"locate", &add_locate_command};
+//   const CommandRegistrar kLocateRegistrar{"locate", &add_locate_command};
+// Each registrar has its own name: ceilposectl compiles its files in batches
+// (unity build), where one anonymous namespace holds several files.
 // The factory adds a CLI11 sub-command whose callback does the work and sets
 // the process exit code through set_exit_code().
 #include <CLI/CLI.hpp>

@@ -122,7 +122,7 @@ void add_evaluate_command(CLI::App& app) {
   });
 }
 
-const CommandRegistrar kReg{"evaluate", &add_evaluate_command};
+const CommandRegistrar kEvaluateRegistrar{"evaluate", &add_evaluate_command};
 
 }  // namespace
 }  // namespace ceilpose::ctl

@@ -258,7 +258,7 @@ void add_fleet_command(CLI::App& app) {
   cmd->callback([args] { set_exit_code(run_fleet(*args)); });
 }
 
-const CommandRegistrar kReg{"fleet", &add_fleet_command};
+const CommandRegistrar kFleetRegistrar{"fleet", &add_fleet_command};
 
 }  // namespace
 }  // namespace ceilpose::ctl

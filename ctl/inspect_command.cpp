@@ -238,7 +238,7 @@ void add_inspect_command(CLI::App& app) {
   cmd->callback([args] { run_inspect(*args); });
 }
 
-const CommandRegistrar kReg{"inspect", &add_inspect_command};
+const CommandRegistrar kInspectRegistrar{"inspect", &add_inspect_command};
 
 }  // namespace
 }  // namespace ceilpose::ctl

@@ -86,7 +86,7 @@ void add_keys_command(CLI::App& app) {
   add_cmd->callback([add] { run_keys_add(*add); });
 }
 
-const CommandRegistrar kReg{"keys", &add_keys_command};
+const CommandRegistrar kKeysRegistrar{"keys", &add_keys_command};
 
 }  // namespace
 }  // namespace ceilpose::ctl

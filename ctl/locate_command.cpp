@@ -127,7 +127,7 @@ void add_locate_command(CLI::App& app) {
   });
 }
 
-const CommandRegistrar kReg{"locate", &add_locate_command};
+const CommandRegistrar kLocateRegistrar{"locate", &add_locate_command};
 
 }  // namespace
 }  // namespace ceilpose::ctl

@@ -148,7 +148,7 @@ void add_markers_command(CLI::App& app) {
   cmd->callback([args] { run_markers(*args); });
 }
 
-const CommandRegistrar kReg{"markers", &add_markers_command};
+const CommandRegistrar kMarkersRegistrar{"markers", &add_markers_command};
 
 }  // namespace
 }  // namespace ceilpose::ctl

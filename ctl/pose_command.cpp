@@ -151,7 +151,7 @@ void add_pose_command(CLI::App& app) {
   });
 }
 
-const CommandRegistrar kReg{"pose", &add_pose_command};
+const CommandRegistrar kPoseRegistrar{"pose", &add_pose_command};
 
 }  // namespace
 }  // namespace ceilpose::ctl

@@ -230,7 +230,7 @@ void add_record_command(CLI::App& app) {
   cmd->callback([args] { set_exit_code(run_record(*args)); });
 }
 
-const CommandRegistrar kReg{"record", &add_record_command};
+const CommandRegistrar kRecordRegistrar{"record", &add_record_command};
 
 }  // namespace
 }  // namespace ceilpose::ctl

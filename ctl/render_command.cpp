@@ -266,7 +266,7 @@ void add_render_command(CLI::App& app) {
   cmd->callback([args] { run_render(*args); });
 }
 
-const CommandRegistrar kReg{"render", &add_render_command};
+const CommandRegistrar kRenderRegistrar{"render", &add_render_command};
 
 }  // namespace
 }  // namespace ceilpose::ctl

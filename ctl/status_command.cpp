@@ -199,7 +199,7 @@ void add_status_command(CLI::App& app) {
   });
 }
 
-const CommandRegistrar kReg{"status", &add_status_command};
+const CommandRegistrar kStatusRegistrar{"status", &add_status_command};
 
 }  // namespace
 }  // namespace ceilpose::ctl

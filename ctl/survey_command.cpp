@@ -251,7 +251,7 @@ void add_survey_command(CLI::App& app) {
   cmd->callback([args] { run_survey(*args); });
 }
 
-const CommandRegistrar kReg{"survey", &add_survey_command};
+const CommandRegistrar kSurveyRegistrar{"survey", &add_survey_command};
 
 }  // namespace
 }  // namespace ceilpose::ctl

@@ -179,7 +179,7 @@ void add_watch_command(CLI::App& app) {
   });
 }
 
-const CommandRegistrar kReg{"watch", &add_watch_command};
+const CommandRegistrar kWatchRegistrar{"watch", &add_watch_command};
 
 }  // namespace
 }  // namespace ceilpose::ctl

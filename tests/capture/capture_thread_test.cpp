@@ -104,11 +104,18 @@ TEST(CaptureThread, ThePipelineGetsTheNewestFrameAndOlderOnesAreSkipped) {
   bool first = true;
   for (int i = 0; i < 8; ++i) {
     // A slow pipeline, by handshake rather than by a sleep: come back only
-    // once the camera has handed the ring three frames more.
-    const uint64_t handed = thread.stats().frames;
+    // once the camera has delivered three frames more. Delivered counts the
+    // frames dropped at a full ring too: a frame that entered the ring
+    // before the count was read leaves room for two more only (budget 3),
+    // and waiting for three handed would wait out the deadline.
+    const auto delivered = [&] {
+      const CaptureStats s = thread.stats();
+      return s.frames + s.drops;
+    };
+    const uint64_t before = delivered();
     const int64_t deadline_ns = monotonic_ns() + 30'000'000'000;
-    while (thread.stats().frames < handed + 3 && monotonic_ns() < deadline_ns)
-      std::this_thread::yield();
+    while (delivered() < before + 3 && monotonic_ns() < deadline_ns) std::this_thread::yield();
+    ASSERT_GE(delivered(), before + 3) << "the camera stopped delivering frames";
     Frame f;
     ASSERT_TRUE(thread.acquire_latest(&f, 5000));
     uint64_t content;
