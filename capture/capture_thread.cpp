@@ -13,6 +13,7 @@
 #include "capture/wait.h"
 #include "core/clock.h"
 #include "core/futex.h"
+#include "core/thread_affinity.h"
 
 namespace ceilpose::capture {
 namespace {
@@ -71,10 +72,7 @@ void CaptureThread::apply_realtime() {
     }
   }
   if (options_.cpu >= 0) {
-    cpu_set_t set;
-    CPU_ZERO(&set);
-    CPU_SET(options_.cpu, &set);
-    const int r = pthread_setaffinity_np(pthread_self(), sizeof set, &set);
+    const int r = pin_thread_to_cpu(pthread_self(), options_.cpu);
     if (r == 0) {
       realtime_.pinned = true;
     } else if (first_time(g_warned_affinity)) {

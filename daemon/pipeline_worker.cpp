@@ -7,6 +7,7 @@
 #include <cmath>
 
 #include "core/clock.h"
+#include "core/thread_affinity.h"
 
 namespace ceilpose::daemon {
 namespace {
@@ -55,6 +56,9 @@ void PipelineWorker::start() {
     realtime_.store(pthread_setschedparam(thread_.native_handle(), SCHED_FIFO, &param) == 0,
                     std::memory_order_release);
   }
+  if (options_.cpu >= 0)
+    pinned_.store(pin_thread_to_cpu(thread_.native_handle(), options_.cpu) == 0,
+                  std::memory_order_release);
 }
 
 void PipelineWorker::stop() {

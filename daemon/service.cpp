@@ -306,6 +306,7 @@ int Service::start_fleet() {
 int Service::start_pipeline() {
   WorkerOptions wopts;
   wopts.rt_priority = config_.capture.pipeline_rt_priority;
+  wopts.cpu = config_.capture.thread.cpu;
   worker_ = std::make_unique<PipelineWorker>(running_config(config_), wopts, capture_.get(), sinks_,
                                              &progress_);
   worker_->start();
@@ -314,11 +315,15 @@ int Service::start_pipeline() {
         "pipeline thread: SCHED_FIFO {} not permitted (needs LimitRTPRIO or "
         "CAP_SYS_NICE); running at normal priority",
         wopts.rt_priority);
-  spdlog::info("ceilposed running: shared memory {}, positioning {}, filter {}{}", shm_->name(),
-               to_string(config_.pipeline.positioning.mode),
-               config_.pipeline.filter.enabled ? "on" : "off",
-               worker_->realtime() ? ", pipeline SCHED_FIFO " + std::to_string(wopts.rt_priority)
-                                   : std::string());
+  if (wopts.cpu >= 0 && !worker_->pinned())
+    spdlog::warn("pipeline thread: cannot pin to CPU {} (capture.cpu); running on any CPU",
+                 wopts.cpu);
+  spdlog::info(
+      "ceilposed running: shared memory {}, positioning {}, filter {}{}{}", shm_->name(),
+      to_string(config_.pipeline.positioning.mode), config_.pipeline.filter.enabled ? "on" : "off",
+      worker_->realtime() ? ", pipeline SCHED_FIFO " + std::to_string(wopts.rt_priority)
+                          : std::string(),
+      worker_->pinned() ? ", pipeline on CPU " + std::to_string(wopts.cpu) : std::string());
   return kExitOk;
 }
 

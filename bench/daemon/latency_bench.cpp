@@ -142,6 +142,7 @@ void BM_FrameToPose(benchmark::State& state, bool replay) {
     daemon::ProgressCounter progress;
     daemon::WorkerOptions wopts;
     wopts.rt_priority = config.capture.pipeline_rt_priority;  // as ceilposed runs it
+    wopts.cpu = config.capture.thread.cpu;
     wopts.latency_warmup_frames = kWarmupFrames;
     daemon::PipelineWorker worker(config, wopts, &capture, sinks, &progress);
 

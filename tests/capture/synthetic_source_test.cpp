@@ -138,10 +138,9 @@ TEST(SyntheticSource, FramesFollowTheConfiguredRateOnTheMonotonicClock) {
   }
 }
 
-// Rendering slower than the frame rate: a SCHED_FIFO capture thread that
-// rendered back to back held its core for good and starved the daemon's own
-// control thread (SIGTERM unanswered for minutes). Every exposure must begin
-// after the previous render ended, so the thread sleeps between renders.
+// Rendering slower than the frame rate: ticks that pass during a render are
+// lost, as a camera loses them, and the next exposure is the next tick after
+// the render ended (25 ms at 100 fps: 30 ms later), never a passed one.
 struct SlowGenerator final : FrameGenerator {
   const CameraIntrinsics& intrinsics() const override { return stamping.k; }
   void generate(int64_t elapsed_ns, uint64_t tick, Image* out, Pose2D* truth) override {
@@ -156,14 +155,17 @@ TEST(SyntheticSource, RenderingSlowerThanTheRateWaitsForTheNextTickNotAPassedOne
   SyntheticSource source(at_rate(100.0), std::make_shared<SlowGenerator>());
   ASSERT_TRUE(source.open());
   ASSERT_TRUE(source.start());
-  int64_t previous_rendered_ns = 0;
+  int64_t previous_ns = 0;
   for (int i = 0; i < 5; ++i) {
     Frame f;
     ASSERT_TRUE(wait_frame(source, &f));
     if (i > 0) {
-      EXPECT_GT(f.capture_ns, previous_rendered_ns) << "frame " << i << " exposed in the past";
+      const int64_t gap_ns = f.capture_ns - previous_ns;
+      EXPECT_GE(gap_ns, 30'000'000) << "frame " << i << " exposed during the previous render";
+      EXPECT_EQ(gap_ns % 10'000'000, 0) << gap_ns;
     }
-    previous_rendered_ns = f.dequeue_ns;
+    EXPECT_GE(f.dequeue_ns, f.capture_ns + 25'000'000) << "handed over before it was rendered";
+    previous_ns = f.capture_ns;
     source.release(f);
   }
   EXPECT_GE(source.stats().drops, 8u);  // >= 2 ticks lost per frame after the first

@@ -654,6 +654,16 @@ TEST_F(DaemonLifecycle, ASyntheticCameraInYuyvIsLocalizedAsAUsbCamerasFramesAre)
   EXPECT_LE(errors_mm.back(), 10.0) << r.out;
 }
 
+// capture.cpu pins both frame-path threads to one CPU (docs/latency.md).
+TEST_F(DaemonLifecycle, CaptureCpuPinsThePipelineThreadBesideTheCaptureThread) {
+  const std::string config =
+      write_temp_file("ceilpose.yaml", config_text() + "capture:\n  cpu: 0\n");
+  auto r = run_daemon({"--config", config, "--shm", shm_, "--duration", "2"});
+  ASSERT_EQ(r.exit.code, ceilpose::kExitOk) << r.err;
+  EXPECT_NE(r.err.find("pipeline on CPU 0"), std::string::npos) << r.err;
+  EXPECT_EQ(r.err.find("cannot pin"), std::string::npos) << r.err;
+}
+
 TEST_F(DaemonLifecycle, PrintPosesShowsGroundTruthAndErrorForTheSyntheticSource) {
   // --duration counts from the daemon's start; under ASan on a loaded 2-core
   // CI machine 1.5 s once passed before the first frame was processed.

@@ -5,6 +5,7 @@
 #include "daemon/pipeline_worker.h"
 
 #include <gtest/gtest.h>
+#include <sched.h>
 #include <unistd.h>
 
 #include <chrono>
@@ -97,6 +98,49 @@ TEST(PipelineWorker, ReportsItsThreadsCpuTimeWhileItRuns) {
   EXPECT_GE(worker.thread_cpu_ns(), first_ns);
   worker.stop();
   EXPECT_EQ(worker.thread_cpu_ns(), 0) << "a joined thread's clock read";
+}
+
+// A worker pinned to `cpu` (WorkerOptions::cpu), started.
+std::unique_ptr<PipelineWorker> start_on_cpu(Rig& rig, int cpu) {
+  WorkerOptions options;
+  options.cpu = cpu;
+  auto worker = std::make_unique<PipelineWorker>(rig.config, options, rig.capture.get(), rig.sinks,
+                                                 &rig.progress);
+  worker->start();
+  return worker;
+}
+
+// ceilposed pins the pipeline thread to capture.cpu: every frame is
+// localized and published on that CPU.
+TEST(PipelineWorker, PinnedToACpuLocalizesEveryFrameThere) {
+  struct CpuSink final : PublishingSink {
+    void consume(const Localization&) override {
+      ++frames;
+      if (sched_getcpu() != 0) ++elsewhere;
+    }
+    void publish_status(const ServiceStatus&) override {}
+    int64_t status_period_ns() const override { return 1'000'000'000; }
+    uint64_t frames = 0, elsewhere = 0;
+  };
+  Rig rig;
+  CpuSink cpu_sink;
+  rig.sinks.push_back(&cpu_sink);
+  const auto worker = start_on_cpu(rig, 0);
+  EXPECT_TRUE(worker->pinned());
+  ASSERT_TRUE(wait_frames(*worker, 5));
+  worker->stop();
+  EXPECT_EQ(cpu_sink.frames, worker->frames());
+  EXPECT_EQ(cpu_sink.elsewhere, 0u) << "frames localized off CPU 0";
+}
+
+// A CPU the process may not use (capture.cpu beyond the machine's) leaves
+// the thread unpinned and says so; the frames still flow.
+TEST(PipelineWorker, ACpuThatCannotBeHadLeavesItUnpinnedAndRunning) {
+  Rig rig;
+  const auto worker = start_on_cpu(rig, 1023);
+  EXPECT_FALSE(worker->pinned());
+  ASSERT_TRUE(wait_frames(*worker, 3));
+  worker->stop();
 }
 
 TEST(PipelineWorker, SnapshotsAndReloadsFromAnotherThreadKeepTheSequenceRising) {
