@@ -14,7 +14,7 @@
 // for next(), as a camera's DMA leaves a buffer for VIDIOC_DQBUF. The
 // capture thread then only waits and hands over, so the pipeline thread can
 // share its CPU (capture.cpu): rendering in the capture thread took 85 % of
-// that CPU at 60 fps and starved it (frame ready -> pose p99 0.3-0.8 s).
+// that CPU at 60 fps and starved it (frame ready -> pose p99 0.3-0.5 s).
 // A rendered frame next() has not taken when the next one is ready is
 // released and counted as a drop.
 #include <condition_variable>

@@ -57,8 +57,8 @@ void PipelineWorker::start() {
                     std::memory_order_release);
   }
   if (options_.cpu >= 0)
-    pinned_.store(pin_thread_to_cpu(thread_.native_handle(), options_.cpu) == 0,
-                  std::memory_order_release);
+    pin_error_.store(pin_thread_to_cpu(thread_.native_handle(), options_.cpu),
+                     std::memory_order_release);
 }
 
 void PipelineWorker::stop() {

@@ -53,7 +53,7 @@ struct WorkerOptions {
   int rt_priority = 0;  // SCHED_FIFO priority of the thread; 0 = normal scheduling
   // Pin the thread to this CPU; -1 = any. ceilposed gives it the capture
   // thread's (capture.cpu): a frame handed over on a busy CPU wakes no idle
-  // one, whose wake-up under a hypervisor took 0.4-1.3 ms at p99
+  // one, whose wake-up under a hypervisor took 0.3-2.2 ms at p99
   // (docs/latency.md).
   int cpu = -1;
   // Frames whose latency is not recorded: the first ones after start touch
@@ -89,8 +89,10 @@ class PipelineWorker {
   uint64_t frames() const { return frames_.load(std::memory_order_relaxed); }
   // Whether the thread got SCHED_FIFO (valid after start()).
   bool realtime() const { return realtime_.load(std::memory_order_acquire); }
-  // Whether the thread was pinned to WorkerOptions::cpu (valid after start()).
-  bool pinned() const { return pinned_.load(std::memory_order_acquire); }
+  // Whether the thread was pinned to WorkerOptions::cpu, and why not: 0, or
+  // pthread_setaffinity_np's error (valid after start()).
+  bool pinned() const { return options_.cpu >= 0 && pin_error() == 0; }
+  int pin_error() const { return pin_error_.load(std::memory_order_acquire); }
   // Frames per refusal since start (any thread).
   const RefusalHistogram& refusals() const { return localizer_.refusals(); }
   // Frames tracked and swept whole, by reason: read after stop().
@@ -128,7 +130,7 @@ class PipelineWorker {
   std::atomic<bool> stop_{false};
   std::atomic<bool> finished_{false};
   std::atomic<bool> realtime_{false};
-  std::atomic<bool> pinned_{false};
+  std::atomic<int> pin_error_{0};
   std::thread thread_;
   pthread_t native_thread_{};  // thread_'s, for its CPU clock from other threads
 

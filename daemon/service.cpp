@@ -316,8 +316,8 @@ int Service::start_pipeline() {
         "CAP_SYS_NICE); running at normal priority",
         wopts.rt_priority);
   if (wopts.cpu >= 0 && !worker_->pinned())
-    spdlog::warn("pipeline thread: cannot pin to CPU {} (capture.cpu); running on any CPU",
-                 wopts.cpu);
+    spdlog::warn("pipeline thread: cannot pin to CPU {} (capture.cpu): {}; running on any CPU",
+                 wopts.cpu, std::strerror(worker_->pin_error()));
   spdlog::info(
       "ceilposed running: shared memory {}, positioning {}, filter {}{}{}", shm_->name(),
       to_string(config_.pipeline.positioning.mode), config_.pipeline.filter.enabled ? "on" : "off",

@@ -8,6 +8,7 @@
 #include <sched.h>
 #include <unistd.h>
 
+#include <cerrno>
 #include <chrono>
 #include <cmath>
 #include <limits>
@@ -139,6 +140,7 @@ TEST(PipelineWorker, ACpuThatCannotBeHadLeavesItUnpinnedAndRunning) {
   Rig rig;
   const auto worker = start_on_cpu(rig, 1023);
   EXPECT_FALSE(worker->pinned());
+  EXPECT_EQ(worker->pin_error(), EINVAL) << "the reason ceilposed logs";
   ASSERT_TRUE(wait_frames(*worker, 3));
   worker->stop();
 }
