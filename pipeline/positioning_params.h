@@ -166,9 +166,10 @@ struct FilterParams {
   // very confident filter does not lock out a slightly-off good measurement.
   double gate_min_m = 0.02;
   double gate_min_rad = 0.03;
-  // After this many consecutive gated measurements the filter believes the
-  // measurements (the robot was moved, or the filter diverged) and
-  // re-initialises on the latest one. Counted in TemporalFilter::stats().
+  // After this many consecutive gated measurements that agree with each
+  // other (each within the gate of a filter of their own) the filter
+  // believes them (the robot was moved, or the filter diverged) and goes on
+  // from their filter. Counted in TemporalFilter::stats().
   int reinit_after_gated = 5;
   // Frames stamped closer together than this (SPEC §4 allows equal stamps)
   // carry no motion the filter can use: fused as one instant, a moving

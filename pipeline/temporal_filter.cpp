@@ -36,12 +36,13 @@ std::array<double, 9> TemporalFilter::floored_covariance(const PoseEstimate& m) 
   return r;
 }
 
-void TemporalFilter::initialise(const PoseEstimate& m, int64_t timestamp_ns) {
-  state_.x.fill(0.0);
-  state_.x[0] = m.pose.x_m;
-  state_.x[1] = m.pose.y_m;
-  state_.x[2] = m.pose.yaw_rad;
-  std::array<double, kN* kN>& p = state_.p;
+MotionState TemporalFilter::initial_state(const PoseEstimate& m) const {
+  MotionState state;
+  state.x.fill(0.0);
+  state.x[0] = m.pose.x_m;
+  state.x[1] = m.pose.y_m;
+  state.x[2] = m.pose.yaw_rad;
+  std::array<double, kN* kN>& p = state.p;
   p.fill(0.0);
   const std::array<double, 9> r = floored_covariance(m);
   for (int row = 0; row < 3; ++row)
@@ -56,17 +57,24 @@ void TemporalFilter::initialise(const PoseEstimate& m, int64_t timestamp_ns) {
                             params_.init_accel_sigma_mps2,
                             params_.init_yaw_accel_sigma_radps2};
   for (int i = 3; i < kN; ++i) p[i * kN + i] = sigma[i] * sigma[i];
+  return state;
+}
+
+void TemporalFilter::initialise(const MotionState& state, int64_t state_ns, const PoseEstimate& m,
+                                int64_t timestamp_ns) {
+  state_ = state;
   initialised_ = true;
-  last_ns_ = last_measurement_ns_ = timestamp_ns;
+  last_ns_ = state_ns;
+  last_measurement_ns_ = timestamp_ns;
   consecutive_gated_ = 0;
   last_mode_ = m.mode;
 }
 
-void TemporalFilter::predict(double dt) {
+void TemporalFilter::predict(MotionState* state, double dt) const {
   if (dt <= 0.0) return;
-  const MotionState before = state_;
-  propagate_motion(before, dt, jerk_density(), &state_);
-  state_.x[2] = wrap_angle_rad(state_.x[2]);
+  const MotionState before = *state;
+  propagate_motion(before, dt, jerk_density(), state);
+  state->x[2] = wrap_angle_rad(state->x[2]);
 }
 
 PoseEstimate TemporalFilter::output(const PoseEstimate* used, int64_t timestamp_ns) const {
@@ -89,14 +97,14 @@ PoseEstimate TemporalFilter::output(const PoseEstimate* used, int64_t timestamp_
 // Innovation y = z - H x (yaw wrapped) and the inverse of its covariance
 // S = P33 + R, R being the measurement's covariance with the floors applied.
 // False when S is singular.
-bool TemporalFilter::innovation(const PoseEstimate& m, std::array<double, 3>* y,
-                                std::array<double, 9>* s_inv) const {
-  *y = {m.pose.x_m - state_.x[0], m.pose.y_m - state_.x[1],
-        wrap_angle_rad(m.pose.yaw_rad - state_.x[2])};
+bool TemporalFilter::innovation(const MotionState& state, const PoseEstimate& m,
+                                std::array<double, 3>* y, std::array<double, 9>* s_inv) const {
+  *y = {m.pose.x_m - state.x[0], m.pose.y_m - state.x[1],
+        wrap_angle_rad(m.pose.yaw_rad - state.x[2])};
   const std::array<double, 9> r = floored_covariance(m);
   std::array<double, 9> s{};
   for (int i = 0; i < 3; ++i)
-    for (int j = 0; j < 3; ++j) s[i * 3 + j] = state_.p[i * kN + j] + r[i * 3 + j];
+    for (int j = 0; j < 3; ++j) s[i * 3 + j] = state.p[i * kN + j] + r[i * 3 + j];
   return invert3(s, s_inv);
 }
 
@@ -109,28 +117,30 @@ bool is_jump(const FilterParams& params, const std::array<double, 3>& y,
 }
 
 // K = P H^T S^-1 (9x3); x += K y; P -= K H P, kept symmetric.
-void TemporalFilter::correct(const std::array<double, 3>& y, const std::array<double, 9>& s_inv) {
+void TemporalFilter::correct(MotionState* state, const std::array<double, 3>& y,
+                             const std::array<double, 9>& s_inv) const {
+  MotionState& st = *state;
   std::array<double, kN * 3> k{};
   for (int i = 0; i < kN; ++i)
     for (int j = 0; j < 3; ++j) {
       double sum = 0.0;
-      for (int l = 0; l < 3; ++l) sum += state_.p[i * kN + l] * s_inv[l * 3 + j];
+      for (int l = 0; l < 3; ++l) sum += st.p[i * kN + l] * s_inv[l * 3 + j];
       k[i * 3 + j] = sum;
     }
   for (int i = 0; i < kN; ++i)
-    for (int j = 0; j < 3; ++j) state_.x[i] += k[i * 3 + j] * y[j];
-  state_.x[2] = wrap_angle_rad(state_.x[2]);
-  std::array<double, kN* kN> p = state_.p;
+    for (int j = 0; j < 3; ++j) st.x[i] += k[i * 3 + j] * y[j];
+  st.x[2] = wrap_angle_rad(st.x[2]);
+  std::array<double, kN* kN> p = st.p;
   for (int i = 0; i < kN; ++i)
     for (int c = 0; c < kN; ++c) {
       double sum = 0.0;
-      for (int j = 0; j < 3; ++j) sum += k[i * 3 + j] * state_.p[j * kN + c];
+      for (int j = 0; j < 3; ++j) sum += k[i * 3 + j] * st.p[j * kN + c];
       p[i * kN + c] -= sum;
     }
   for (int i = 0; i < kN; ++i)  // against round-off
     for (int c = i + 1; c < kN; ++c)
       p[i * kN + c] = p[c * kN + i] = 0.5 * (p[i * kN + c] + p[c * kN + i]);
-  state_.p = p;
+  st.p = p;
 }
 
 PoseEstimate TemporalFilter::coast(int64_t frame_ns) {
@@ -143,6 +153,26 @@ PoseEstimate TemporalFilter::coast(int64_t frame_ns) {
     return PoseEstimate{};
   }
   return out;
+}
+
+// The gated measurements in a row, in a filter of their own (candidate_):
+// each one within that filter's gate is fused into it and counted; one
+// beyond it (they disagree among themselves: a wrong decode among them, or
+// the robot moved again) starts it afresh. Returns how many in a row agree.
+int TemporalFilter::follow_gated(const PoseEstimate& m, int64_t timestamp_ns) {
+  if (consecutive_gated_ > 0) {
+    predict(&candidate_, std::max<int64_t>(0, timestamp_ns - candidate_ns_) * 1e-9);
+    candidate_ns_ = std::max(candidate_ns_, timestamp_ns);
+    std::array<double, 3> y{};
+    std::array<double, 9> s_inv{};
+    if (innovation(candidate_, m, &y, &s_inv) && !is_jump(params_, y, s_inv)) {
+      correct(&candidate_, y, s_inv);
+      return ++consecutive_gated_;
+    }
+  }
+  candidate_ = initial_state(m);
+  candidate_ns_ = timestamp_ns;
+  return consecutive_gated_ = 1;
 }
 
 PoseEstimate TemporalFilter::update(const PoseEstimate& m, int64_t frame_ns) {
@@ -159,25 +189,26 @@ PoseEstimate TemporalFilter::update(const PoseEstimate& m, int64_t frame_ns) {
   if (!initialised_ || too_close) {
     if (!m.valid) return PoseEstimate{};
     if (too_close) ++stats_.close_restarts;
-    initialise(m, timestamp_ns);
+    initialise(initial_state(m), timestamp_ns, m, timestamp_ns);
     last_frame_ns_ = frame_ns;
     ++stats_.updates;
     return output(&m, frame_ns);
   }
-  predict(std::max<int64_t>(0, timestamp_ns - last_ns_) * 1e-9);
+  predict(&state_, std::max<int64_t>(0, timestamp_ns - last_ns_) * 1e-9);
   last_ns_ = std::max(last_ns_, timestamp_ns);
   std::array<double, 3> y{};
   std::array<double, 9> s_inv{};
-  if (!m.valid || !innovation(m, &y, &s_inv)) {
+  if (!m.valid || !innovation(state_, m, &y, &s_inv)) {
     return coast(frame_ns);
   }
   if (is_jump(params_, y, s_inv)) {
     ++stats_.gated;
-    if (++consecutive_gated_ >= params_.reinit_after_gated) {
+    if (follow_gated(m, timestamp_ns) >= params_.reinit_after_gated) {
       // The measurements have agreed with each other, not with us, for long
-      // enough: the robot was moved or the filter diverged.
+      // enough: the robot was moved or the filter diverged. The filter goes
+      // on from theirs, which has their motion too.
       ++stats_.reinitialisations;
-      initialise(m, timestamp_ns);
+      initialise(candidate_, candidate_ns_, m, timestamp_ns);
       last_frame_ns_ = frame_ns;
       return output(&m, frame_ns);
     }
@@ -187,7 +218,7 @@ PoseEstimate TemporalFilter::update(const PoseEstimate& m, int64_t frame_ns) {
     // model allows), so neither is published (docs/decisions.md).
     return PoseEstimate{};
   }
-  correct(y, s_inv);
+  correct(&state_, y, s_inv);
   consecutive_gated_ = 0;
   last_measurement_ns_ = timestamp_ns;
   last_frame_ns_ = frame_ns;

@@ -44,8 +44,9 @@ class TemporalFilter {
   // predict_timeout_ms passes without one; a prediction without a fused
   // measurement is invalid (the state carries on) once its sd passes
   // coast_max_sd_m or coast_max_yaw_sd_rad; a frame whose measurement is a
-  // jump (is_jump) is invalid too, until reinit_after_gated in a row restart
-  // the filter on it. An instant earlier than the
+  // jump (is_jump) is invalid too, until reinit_after_gated in a row that
+  // agree with each other (each within the gate of a filter of their own)
+  // restart the filter on theirs. An instant earlier than the
   // previous one is treated as the same instant. A valid measurement of a
   // frame stamped within min_frame_interval_ms of the last one fused (or
   // earlier) restarts the filter on itself.
@@ -65,14 +66,22 @@ class TemporalFilter {
  private:
   static constexpr int kN = kMotionStates;
   std::array<double, 9> floored_covariance(const PoseEstimate& m) const;
-  void initialise(const PoseEstimate& measurement, int64_t timestamp_ns);
-  void predict(double dt_s);
-  bool innovation(const PoseEstimate& m, std::array<double, 3>* y,
+  // The state a first measurement gives: its pose and covariance, motion
+  // unknown (the init sigmas).
+  MotionState initial_state(const PoseEstimate& measurement) const;
+  // Starts (again) from `state` at state_ns, `measurement` the last fused.
+  void initialise(const MotionState& state, int64_t state_ns, const PoseEstimate& measurement,
+                  int64_t timestamp_ns);
+  int follow_gated(const PoseEstimate& measurement, int64_t timestamp_ns);
+  // The Kalman steps, on the filter's state or the gated measurements'.
+  void predict(MotionState* state, double dt_s) const;
+  bool innovation(const MotionState& state, const PoseEstimate& m, std::array<double, 3>* y,
                   std::array<double, 9>* s_inv) const;
   // The prediction to frame_ns without a measurement, invalid past the
   // coasting bounds.
   PoseEstimate coast(int64_t frame_ns);
-  void correct(const std::array<double, 3>& y, const std::array<double, 9>& s_inv);
+  void correct(MotionState* state, const std::array<double, 3>& y,
+               const std::array<double, 9>& s_inv) const;
   PoseEstimate output(const PoseEstimate* used, int64_t timestamp_ns) const;
 
   FilterParams params_;
@@ -82,7 +91,9 @@ class TemporalFilter {
   int64_t last_ns_ = 0;              // time the state refers to
   int64_t last_measurement_ns_ = 0;  // last fused (or initialising) measurement
   int64_t last_frame_ns_ = 0;        // the frame stamp of that measurement
-  int consecutive_gated_ = 0;
+  int consecutive_gated_ = 0;        // gated in a row that agree with each other
+  MotionState candidate_;            // their filter (follow_gated)
+  int64_t candidate_ns_ = 0;
   PositioningMode last_mode_ = PositioningMode::kAuto;
 };
 

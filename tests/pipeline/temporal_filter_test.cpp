@@ -173,6 +173,53 @@ TEST(TemporalFilter, ReinitialisesAfterConsecutiveGatedMeasurements) {
   EXPECT_EQ(filter.stats().gated, 4u);
 }
 
+// Gated measurements that disagree with each other (two places 2 m apart,
+// alternating: a wrong decode among them) do not restart the filter, however
+// many in a row: the fifth gated one used to be believed, whatever it was.
+// (Twelve frames: at predict_timeout_ms without a fused measurement the
+// filter starts again from nothing, as at start-up.)
+TEST(TemporalFilter, GatedMeasurementsThatDisagreeWithEachOtherNeverRestartIt) {
+  TemporalFilter filter{gate_alone()};  // reinit_after_gated 5, timeout 500 ms
+  for (int k = 0; k < 30; ++k) filter.update(measurement(1.0, 1.0, 0.0), k * kFrameNs);
+  for (int k = 30; k < 42; ++k) {
+    const double x = k % 2 == 0 ? 3.0 : 5.0;
+    EXPECT_FALSE(filter.update(measurement(x, 1.0, 0.0), k * kFrameNs).valid) << "frame " << k;
+  }
+  EXPECT_EQ(filter.stats().reinitialisations, 0u);
+  EXPECT_EQ(filter.stats().gated, 12u);
+  // One that agrees with the filter is fused as before.
+  const PoseEstimate back = filter.update(measurement(1.0, 1.0, 0.0), 42 * kFrameNs);
+  ASSERT_TRUE(back.valid);
+  EXPECT_NEAR(back.pose.x_m, 1.0, 0.005);
+}
+
+// A robot standing still, then moving at 0.75 m/s from one frame to the
+// next (a step no drive makes, or a push): the measurements are gated, and
+// once five in a row agree the filter goes on from their own filter, with
+// their motion (a restart on the last one alone had none), and nothing is
+// gated after it.
+TEST(TemporalFilter, RestartsOnAgreeingGatedMeasurementsWithTheirMotion) {
+  TemporalFilter filter{gate_alone()};
+  for (int k = 0; k < 30; ++k) filter.update(measurement(1.0, 1.0, 0.0, 0.0002), k * kFrameNs);
+  int restart_frame = -1;
+  uint64_t gated_at_restart = 0;
+  for (int k = 30; k < 60; ++k) {
+    const double x_m = 1.0 + 0.75 * (k - 29) * kFrameNs * 1e-9;
+    const PoseEstimate out = filter.update(measurement(x_m, 1.0, 0.0, 0.0002), k * kFrameNs);
+    if (out.valid) {
+      EXPECT_NEAR(out.pose.x_m, x_m, 0.002) << "frame " << k;
+    }
+    if (restart_frame < 0 && filter.stats().reinitialisations == 1) {
+      restart_frame = k;
+      gated_at_restart = filter.stats().gated;
+      EXPECT_NEAR(filter.state().x[3], 0.75, 0.02) << "the restart's velocity, m/s";
+    }
+  }
+  ASSERT_GE(restart_frame, 0) << "never restarted";
+  EXPECT_EQ(filter.stats().reinitialisations, 1u);
+  EXPECT_EQ(filter.stats().gated, gated_at_restart) << "gated again after the restart";
+}
+
 TEST(TemporalFilter, PredictsThroughMissingFramesThenTimesOut) {
   FilterParams params = gate_alone();  // the timeout alone
   params.predict_timeout_ms = 200.0;
