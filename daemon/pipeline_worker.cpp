@@ -48,9 +48,10 @@ void PipelineWorker::start() {
   thread_ = std::thread([this] { run(); });
   native_thread_ = thread_.native_handle();
   pthread_setname_np(thread_.native_handle(), "ceilpose-pipe");
+  // From here rather than the thread itself so that the result is known
+  // (and logged by the caller) when start() returns; the thread takes its
+  // first frame only once its priority and CPU are set (configured_).
   if (options_.rt_priority > 0) {
-    // From here rather than the thread itself so that the result is known
-    // (and logged by the caller) before the first frame.
     sched_param param{};
     param.sched_priority = options_.rt_priority;
     realtime_.store(pthread_setschedparam(thread_.native_handle(), SCHED_FIFO, &param) == 0,
@@ -59,6 +60,8 @@ void PipelineWorker::start() {
   if (options_.cpu >= 0)
     pin_error_.store(pin_thread_to_cpu(thread_.native_handle(), options_.cpu),
                      std::memory_order_release);
+  configured_.store(true, std::memory_order_release);
+  configured_.notify_one();
 }
 
 void PipelineWorker::stop() {
@@ -78,6 +81,7 @@ PoseSnapshot PipelineWorker::latest() const {
 }
 
 void PipelineWorker::run() {
+  configured_.wait(false, std::memory_order_acquire);
   fps_ns_ = monotonic_ns();
   while (!stop_.load(std::memory_order_acquire)) {
     if (has_pending_.load(std::memory_order_acquire)) apply_pending();

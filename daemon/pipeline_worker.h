@@ -131,6 +131,7 @@ class PipelineWorker {
   std::atomic<bool> finished_{false};
   std::atomic<bool> realtime_{false};
   std::atomic<int> pin_error_{0};
+  std::atomic<bool> configured_{false};  // start() has set the thread's priority and CPU
   std::thread thread_;
   pthread_t native_thread_{};  // thread_'s, for its CPU clock from other threads
 
