@@ -57,8 +57,6 @@ constexpr int kMaxTileSaturationNum = 3;
 constexpr int kMaxTileSaturationDen = 5;
 constexpr float kTileWindow = 0.15f;
 constexpr int kTileChromaWindow = 10;
-constexpr float kMinGain = 0.25f;
-constexpr float kMaxGain = 4.0f;
 
 float hue_deg(int r, int g, int b, int v, int m) {
   const float d = static_cast<float>(v - m);
@@ -120,9 +118,7 @@ void ColorClassifier::set_params(const DetectorParams& params, Rgb tile) {
   for (int qr = 0; qr < kCells; ++qr)
     for (int qg = 0; qg < kCells; ++qg)
       for (int qb = 0; qb < kCells; ++qb) {
-        const size_t idx = (static_cast<size_t>(qr) << (2 * kBitsPerChannel)) |
-                           (static_cast<size_t>(qg) << kBitsPerChannel) | qb;
-        lut_[idx] = static_cast<uint8_t>(classify_normalised(
+        lut_[lut_index(qr, qg, qb)] = static_cast<uint8_t>(classify_normalised(
             qr * kStep + kStep / 2, qg * kStep + kStep / 2, qb * kStep + kStep / 2));
       }
   background_cells_.build(lut_.data(), kBitsPerChannel);
@@ -135,16 +131,18 @@ void ColorClassifier::set_params(const DetectorParams& params, Rgb tile) {
 }
 
 void ColorClassifier::set_gains(const std::array<float, 3>& gains) {
-  gains_ = gains;
-  constexpr int kShift = 8 - kBitsPerChannel;
   for (int c = 0; c < 3; ++c) {
-    const int place = (2 - c) * kBitsPerChannel;
-    // Fixed point (16 fractional bits) with rounding: 768 entries per frame.
-    const auto gain_q16 = static_cast<int64_t>(gains_[c] * 65536.0f + 0.5f);
-    for (int level = 0; level < 256; ++level) {
-      const auto norm = std::min<int64_t>(255, (level * gain_q16 + 32768) >> 16);
-      tables_[c][level] = static_cast<uint32_t>(norm >> kShift) << place;
-    }
+    // NaN to the least gain: std::clamp would pass it through.
+    gains_[c] = gains[c] >= kMinGain ? std::min(gains[c], kMaxGain) : kMinGain;
+  }
+  // Fixed point (16 fractional bits) with rounding: 768 entries per frame.
+  auto q16 = [](float gain) { return static_cast<int32_t>(gain * 65536.0f + 0.5f); };
+  gains_q16_ = {q16(gains_[0]), q16(gains_[1]), q16(gains_[2])};
+  const std::array<int32_t, 3> gain_q16{gains_q16_.r, gains_q16_.g, gains_q16_.b};
+  for (int level = 0; level < 256; ++level) {
+    tables_[0][level] = lut_index(cell_of(level, gain_q16[0]), 0, 0);
+    tables_[1][level] = lut_index(0, cell_of(level, gain_q16[1]), 0);
+    tables_[2][level] = lut_index(0, 0, cell_of(level, gain_q16[2]));
   }
   // Around the raw colour these gains take to the nominal tile: the tile.
   const Yuv tile = rgb_to_yuv(tile_.r / gains_[0], tile_.g / gains_[1], tile_.b / gains_[2]);

@@ -22,6 +22,25 @@ class ColorClassifier {
  public:
   static constexpr int kBitsPerChannel = 6;
   static constexpr int kCells = 1 << kBitsPerChannel;
+  // The normalisation's gains (kMinGain..kMaxGain) in 16 fractional bits.
+  static constexpr float kMinGain = 0.25f;
+  static constexpr float kMaxGain = 4.0f;
+  struct GainsQ16 {
+    int32_t r, g, b;
+  };
+
+  // The cell (0..kCells - 1) of a raw level under a gain in 16 fractional
+  // bits: the normalised level (rounded, at most 255) quantised. Level and
+  // gain are bounded, so the product fits in 32 bits, which vectorises.
+  static constexpr int cell_of(int level, int32_t gain_q16) {
+    static_assert(255 * static_cast<int64_t>(kMaxGain * 65536.0f) + 32768 <= INT32_MAX);
+    return std::min(kCells - 1, (level * gain_q16 + 32768) >> (16 + 8 - kBitsPerChannel));
+  }
+  // The lookup table's index of a colour's three cells.
+  static constexpr uint32_t lut_index(int cell_r, int cell_g, int cell_b) {
+    return static_cast<uint32_t>(cell_r) << (2 * kBitsPerChannel) |
+           static_cast<uint32_t>(cell_g) << kBitsPerChannel | static_cast<uint32_t>(cell_b);
+  }
 
   // Builds the lookup table (≈ 10 ms, 256 KiB). `tile` is the nominal tile
   // colour the frame is normalised to.
@@ -36,11 +55,14 @@ class ColorClassifier {
   // is then used, never an earlier frame's.
   bool adapt(const ImageView& frame);
 
-  // Normalisation tables: table(c)[level] is the channel's normalised,
-  // quantised level already shifted into its place in the lookup index, so
-  // that class = lut()[table(0)[r] | table(1)[g] | table(2)[b]].
+  // Normalisation tables: table(c)[level] is the channel's cell (cell_of)
+  // already shifted into its place in the lookup index, so that class =
+  // lut()[table(0)[r] | table(1)[g] | table(2)[b]] = lut()[lut_index(cell_of
+  // (r, gains_q16().r), ...)]: the tables for sparse reads, the arithmetic
+  // for a sweep's vectors.
   const uint32_t* table(int channel) const { return tables_[channel].data(); }
   const uint8_t* lut() const { return lut_.data(); }
+  const GainsQ16& gains_q16() const { return gains_q16_; }
 
   PixelClass classify(uint8_t r, uint8_t g, uint8_t b) const {
     return static_cast<PixelClass>(lut_[tables_[0][r] | tables_[1][g] | tables_[2][b]]);
@@ -50,7 +72,8 @@ class ColorClassifier {
   PixelClass classify_normalised(int r, int g, int b) const;
 
   // Current per-channel gains (normalised = raw × gain) and the measured
-  // tile reference (raw levels) they came from.
+  // tile reference (raw levels) they came from. set_gains holds each gain
+  // to kMinGain..kMaxGain, as adapt does.
   const std::array<float, 3>& gains() const { return gains_; }
   const std::array<float, 3>& reference() const { return reference_; }
   void set_gains(const std::array<float, 3>& gains);
@@ -71,6 +94,7 @@ class ColorClassifier {
   std::vector<uint8_t> lut_;
   std::array<std::array<uint32_t, 256>, 3> tables_{};
   std::array<float, 3> gains_{1.0f, 1.0f, 1.0f};
+  GainsQ16 gains_q16_{65536, 65536, 65536};
   std::array<float, 3> reference_{};
   BackgroundCells background_cells_;
   YuvBox background_yuv_;

@@ -228,19 +228,24 @@ void outside_box(const uint8_t* in, int count, Convert&& convert) {
 }
 
 // BT.601 (video range) from luma and chroma x16 to 0..255 levels, in ints
-// scaled by 2^12. A function of its own so that the compiler knows the
-// arrays do not overlap and vectorises the loop.
-CEILPOSE_VECTOR_CLONES void bt601_levels(const int16_t* __restrict luma,
-                                         const int16_t* __restrict u16,
-                                         const int16_t* __restrict v16, uint8_t* __restrict r,
-                                         uint8_t* __restrict g, uint8_t* __restrict b, int n) {
-  auto level = [](int v) { return static_cast<uint8_t>(std::clamp(v >> 12, 0, 255)); };
+// scaled by 2^12, and on to each pixel's lookup index under the frame's
+// gains: the normalisation tables' arithmetic in vectors, not three table
+// reads a pixel (callgrind: a halved 640x480 YUYV sweep's classification
+// 0.91 -> 0.76 M instructions). A function of its own so that the compiler
+// knows the arrays do not overlap and vectorises the loop.
+CEILPOSE_VECTOR_CLONES void bt601_indices(const int16_t* __restrict luma,
+                                          const int16_t* __restrict u16,
+                                          const int16_t* __restrict v16,
+                                          ColorClassifier::GainsQ16 gains,
+                                          uint32_t* __restrict index, int n) {
+  auto level = [](int v) { return std::clamp(v >> 12, 0, 255); };
   for (int i = 0; i < n; ++i) {
     const int c = 16 * (298 * (luma[i] - 16) + 128);
     const int d = u16[i] - 16 * 128, e = v16[i] - 16 * 128;
-    r[i] = level(c + 409 * e);
-    g[i] = level(c - 100 * d - 208 * e);
-    b[i] = level(c + 516 * d);
+    index[i] =
+        ColorClassifier::lut_index(ColorClassifier::cell_of(level(c + 409 * e), gains.r),
+                                   ColorClassifier::cell_of(level(c - 100 * d - 208 * e), gains.g),
+                                   ColorClassifier::cell_of(level(c + 516 * d), gains.b));
   }
 }
 
@@ -256,14 +261,11 @@ void lookup_rgb(const uint8_t* p, bool rgb, const ColorClassifier& classifier, u
   for (int i = 0; i < count; ++i, p += kStep) out[i] = lut[t0[p[0]] | t1[p[1]] | t2[p[2]]];
 }
 
-// The fused lookup of `count` pixels' normalisation-table levels.
-void lookup_levels(const uint8_t* r, const uint8_t* g, const uint8_t* b,
-                   const ColorClassifier& classifier, uint8_t* out, int count) {
+// The classes of `count` pixels' lookup indices.
+void lookup_indices(const uint32_t* index, const ColorClassifier& classifier, uint8_t* out,
+                    int count) {
   const uint8_t* lut = classifier.lut();
-  const uint32_t* tr = classifier.table(0);
-  const uint32_t* tg = classifier.table(1);
-  const uint32_t* tb = classifier.table(2);
-  for (int i = 0; i < count; ++i) out[i] = lut[tr[r[i]] | tg[g[i]] | tb[b[i]]];
+  for (int i = 0; i < count; ++i) out[i] = lut[index[i]];
 }
 
 }  // namespace
@@ -310,7 +312,8 @@ void ComponentLabeler::resize(int width_px, int height_px) {
   const size_t pairs_padded = static_cast<size_t>(width_ / 2) + kRowPadding;
   for (auto* v : {&pair_u_, &pair_v_}) v->assign(pairs_padded, 0);
   for (auto* v : {&px_y_, &px_u_, &px_v_}) v->assign(pixels_padded, 0);
-  for (auto* v : {&px_r_, &px_g_, &px_b_, &in_box_}) v->assign(pixels_padded, 0);
+  px_index_.assign(pixels_padded, 0);
+  in_box_.assign(pixels_padded, 0);
   spans_.resize(static_cast<size_t>(height_) * kReservedSpansPerRow);
   swept_.reserve(kReservedSpansPerRow);
   runs_.resize(static_cast<size_t>(max_runs_) + 1);
@@ -366,10 +369,9 @@ void ComponentLabeler::classify_yuv_span(const ImageView& frame, int y, int x0, 
   // each side: the buffers are a pixel wider than the frame).
   interpolate_chroma(pu, px_u_.data() + 2 * p0, pairs);
   interpolate_chroma(pv, px_v_.data() + 2 * p0, pairs);
-  bt601_levels(py + x0, px_u_.data() + x0, px_v_.data() + x0, px_r_.data() + x0, px_g_.data() + x0,
-               px_b_.data() + x0, x1 - x0 + 1);
-  lookup_levels(px_r_.data() + x0, px_g_.data() + x0, px_b_.data() + x0, classifier,
-                row_class_.data() + x0, x1 - x0 + 1);
+  bt601_indices(py + x0, px_u_.data() + x0, px_v_.data() + x0, classifier.gains_q16(),
+                px_index_.data() + x0, x1 - x0 + 1);
+  lookup_indices(px_index_.data() + x0, classifier, row_class_.data() + x0, x1 - x0 + 1);
 }
 
 void ComponentLabeler::classify_span(const ImageView& frame, int y, int x0, int x1,
@@ -771,10 +773,8 @@ void ComponentLabeler::classify_sampled_row(const ImageView& frame, int y, int s
           planar_sampled(row + 2 * pairs * b, pairs, u + c, v + c, chroma_step, py + b, pu + b,
                          pv + b, e - b);
         }
-        bt601_levels(py + b, pu + b, pv + b, px_r_.data() + b, px_g_.data() + b, px_b_.data() + b,
-                     e - b);
-        lookup_levels(px_r_.data() + b, px_g_.data() + b, px_b_.data() + b, classifier, out + b,
-                      e - b);
+        bt601_indices(py + b, pu + b, pv + b, classifier.gains_q16(), px_index_.data() + b, e - b);
+        lookup_indices(px_index_.data() + b, classifier, out + b, e - b);
       };
       const YuvBox& box = classifier.background_yuv();
       if (box.empty()) {

@@ -140,10 +140,11 @@ class ComponentLabeler {
   std::vector<uint8_t> row_edge_;   // 1: a window's edge inside the frame (tracked sweeps)
   // A YUV span in stages, each a plain loop the compiler vectorises (SSE2,
   // NEON): per pair chroma ×4 (one pair of margin each side), per pixel
-  // luma and chroma ×16, then the three normalisation-table indices.
+  // luma and chroma ×16, then the lookup index (the normalisation in
+  // arithmetic, ColorClassifier::cell_of).
   std::vector<int16_t> pair_u_, pair_v_;
   std::vector<int16_t> px_y_, px_u_, px_v_;
-  std::vector<uint8_t> px_r_, px_g_, px_b_;
+  std::vector<uint32_t> px_index_;
   // Per sample of a sampled row (per pixel pair of a full-resolution
   // span): 1 where it lies in the classifier's background box (nothing to
   // convert or look up).

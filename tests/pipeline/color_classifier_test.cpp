@@ -2,7 +2,9 @@
 
 #include <gtest/gtest.h>
 
+#include <array>
 #include <cmath>
+#include <cstdint>
 #include <utility>
 #include <vector>
 
@@ -172,6 +174,42 @@ TEST_F(ColorClassifierTest, GreyPixelsAreNeverRedOrGreen) {
     const auto c = static_cast<uint8_t>(v);
     const PixelClass k = classifier.classify(c, c, c);
     EXPECT_TRUE(k == PixelClass::kBackground || k == PixelClass::kDark) << v;
+  }
+}
+
+// A YUV sweep computes each pixel's cell (ColorClassifier::cell_of) where a
+// sparse read looks it up: both must be the normalised level (level × gain,
+// rounded, at most 255) quantised to kCells, for every level and every gain
+// the classifier holds, and the tables must be the cells in their places.
+TEST_F(ColorClassifierTest, CellArithmeticIsTheQuantisedNormalisedLevel) {
+  constexpr int kShift = 8 - ColorClassifier::kBitsPerChannel;
+  const auto lo = static_cast<int32_t>(ColorClassifier::kMinGain * 65536.0f);
+  const auto hi = static_cast<int32_t>(ColorClassifier::kMaxGain * 65536.0f) + 1;
+  int wrong = 0;
+  for (int32_t gain_q16 = lo; gain_q16 <= hi; gain_q16 += 7) {
+    for (int level = 0; level < 256; ++level) {
+      const int64_t normalised = std::min<int64_t>(255, (level * int64_t{gain_q16} + 32768) >> 16);
+      wrong += ColorClassifier::cell_of(level, gain_q16) != (normalised >> kShift);
+    }
+  }
+  EXPECT_EQ(wrong, 0);
+  for (const std::array<float, 3> gains :
+       {std::array<float, 3>{1.0f, 1.0f, 1.0f}, std::array<float, 3>{0.25f, 1.37f, 4.0f},
+        std::array<float, 3>{0.1f, NAN, 9.0f}}) {
+    classifier.set_gains(gains);
+    const ColorClassifier::GainsQ16 q = classifier.gains_q16();
+    for (int c = 0; c < 3; ++c) {
+      EXPECT_GE(classifier.gains()[c], ColorClassifier::kMinGain) << c;
+      EXPECT_LE(classifier.gains()[c], ColorClassifier::kMaxGain) << c;
+    }
+    for (int level = 0; level < 256; ++level) {
+      EXPECT_EQ(classifier.table(0)[level],
+                ColorClassifier::lut_index(ColorClassifier::cell_of(level, q.r), 0, 0));
+      EXPECT_EQ(classifier.table(1)[level],
+                ColorClassifier::lut_index(0, ColorClassifier::cell_of(level, q.g), 0));
+      EXPECT_EQ(classifier.table(2)[level],
+                ColorClassifier::lut_index(0, 0, ColorClassifier::cell_of(level, q.b)));
+    }
   }
 }
 
