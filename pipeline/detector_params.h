@@ -130,8 +130,8 @@ struct DetectorParams {
   // (issue 29); the whole frame when the fix is lost, when a window comes
   // back without its marker, and every full_sweep_every frames (1 s at 30
   // fps; 1 = never track; the daemon and `locate` sweep that frame whole
-  // after its tracked pose, as a check: Localizer::check_scheduled). Markers entering the view need no full sweep:
-  // every marker of the map the view can hold gets a window.
+  // after its tracked pose, as a check: Localizer::check_scheduled). Markers entering the view need
+  // no full sweep: every marker of the map the view can hold gets a window.
   bool tracking = true;
   // A tracked frame measured at the predicted markers' edges (in linear
   // light) and dots alone (no classification, no components: the
