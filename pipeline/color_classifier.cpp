@@ -138,11 +138,10 @@ void ColorClassifier::set_gains(const std::array<float, 3>& gains) {
   // Fixed point (16 fractional bits) with rounding: 768 entries per frame.
   auto q16 = [](float gain) { return static_cast<int32_t>(gain * 65536.0f + 0.5f); };
   gains_q16_ = {q16(gains_[0]), q16(gains_[1]), q16(gains_[2])};
-  const std::array<int32_t, 3> gain_q16{gains_q16_.r, gains_q16_.g, gains_q16_.b};
   for (int level = 0; level < 256; ++level) {
-    tables_[0][level] = lut_index(cell_of(level, gain_q16[0]), 0, 0);
-    tables_[1][level] = lut_index(0, cell_of(level, gain_q16[1]), 0);
-    tables_[2][level] = lut_index(0, 0, cell_of(level, gain_q16[2]));
+    tables_[0][level] = lut_index(cell_of(level, gains_q16_.r), 0, 0);
+    tables_[1][level] = lut_index(0, cell_of(level, gains_q16_.g), 0);
+    tables_[2][level] = lut_index(0, 0, cell_of(level, gains_q16_.b));
   }
   // Around the raw colour these gains take to the nominal tile: the tile.
   const Yuv tile = rgb_to_yuv(tile_.r / gains_[0], tile_.g / gains_[1], tile_.b / gains_[2]);

@@ -22,7 +22,8 @@ class ColorClassifier {
  public:
   static constexpr int kBitsPerChannel = 6;
   static constexpr int kCells = 1 << kBitsPerChannel;
-  // The normalisation's gains (kMinGain..kMaxGain) in 16 fractional bits.
+  // The range of the normalisation's gains, and the three gains in 16
+  // fractional bits.
   static constexpr float kMinGain = 0.25f;
   static constexpr float kMaxGain = 4.0f;
   struct GainsQ16 {
