@@ -70,11 +70,13 @@ void TemporalFilter::initialise(const MotionState& state, int64_t state_ns, cons
   last_mode_ = m.mode;
 }
 
-void TemporalFilter::predict(MotionState* state, double dt) const {
-  if (dt <= 0.0) return;
+// An instant earlier than the state's is treated as the same instant.
+void TemporalFilter::predict(MotionState* state, int64_t* state_ns, int64_t to_ns) const {
+  if (to_ns <= *state_ns) return;
   const MotionState before = *state;
-  propagate_motion(before, dt, jerk_density(), state);
+  propagate_motion(before, static_cast<double>(to_ns - *state_ns) * 1e-9, jerk_density(), state);
   state->x[2] = wrap_angle_rad(state->x[2]);
+  *state_ns = to_ns;
 }
 
 PoseEstimate TemporalFilter::output(const PoseEstimate* used, int64_t timestamp_ns) const {
@@ -161,8 +163,7 @@ PoseEstimate TemporalFilter::coast(int64_t frame_ns) {
 // the robot moved again) starts it afresh. Returns how many in a row agree.
 int TemporalFilter::follow_gated(const PoseEstimate& m, int64_t timestamp_ns) {
   if (consecutive_gated_ > 0) {
-    predict(&candidate_, std::max<int64_t>(0, timestamp_ns - candidate_ns_) * 1e-9);
-    candidate_ns_ = std::max(candidate_ns_, timestamp_ns);
+    predict(&candidate_, &candidate_ns_, timestamp_ns);
     std::array<double, 3> y{};
     std::array<double, 9> s_inv{};
     if (innovation(candidate_, m, &y, &s_inv) && !is_jump(params_, y, s_inv)) {
@@ -194,8 +195,7 @@ PoseEstimate TemporalFilter::update(const PoseEstimate& m, int64_t frame_ns) {
     ++stats_.updates;
     return output(&m, frame_ns);
   }
-  predict(&state_, std::max<int64_t>(0, timestamp_ns - last_ns_) * 1e-9);
-  last_ns_ = std::max(last_ns_, timestamp_ns);
+  predict(&state_, &last_ns_, timestamp_ns);
   std::array<double, 3> y{};
   std::array<double, 9> s_inv{};
   if (!m.valid || !innovation(state_, m, &y, &s_inv)) {

@@ -74,7 +74,8 @@ class TemporalFilter {
                   int64_t timestamp_ns);
   int follow_gated(const PoseEstimate& measurement, int64_t timestamp_ns);
   // The Kalman steps, on the filter's state or the gated measurements'.
-  void predict(MotionState* state, double dt_s) const;
+  // predict moves a state at *state_ns on to to_ns (and *state_ns with it).
+  void predict(MotionState* state, int64_t* state_ns, int64_t to_ns) const;
   bool innovation(const MotionState& state, const PoseEstimate& m, std::array<double, 3>* y,
                   std::array<double, 9>* s_inv) const;
   // The prediction to frame_ns without a measurement, invalid past the
