@@ -143,6 +143,9 @@ double reference_limit_n_m(const CeilingLayout& layout) {
 }
 double reference_spread_e_m(const CeilingLayout& layout) { return 0.25 * layout.rect_width_m; }
 constexpr double kReferenceSpreadN = 0.1;
+// How far along North a marker frame its edges placed has its dots sought
+// from their slots.
+constexpr double kEdgePlacedDotSearch_m = 0.25 * kInch_m;
 
 }  // namespace
 
@@ -190,10 +193,11 @@ MarkerRegion::MarkerRegion(const MarkerFrame& marker, double e0_m, double e1_m, 
 void ask_marker_region(const ImageView& frame, const MarkerFrame& marker, double e0_m, double e1_m,
                        double n0_m, double n1_m) {
   const MarkerRegion region(marker, e0_m, e1_m, n0_m, n1_m, frame.width, frame.height);
-  for (int y = region.first_row(); y <= region.last_row(); ++y) {
-    const PixelSpan span = region.row(y);
-    if (span.x0 <= span.x1) prefetch_pixels(frame, y, span.x0, span.x1);
-  }
+  // One format dispatch for the region's ~130 rows (640x480).
+  with_pixel_format(frame.format, [&](auto tag) {
+    region.for_each_span(
+        [&](int y, int x0, int x1) { prefetch_pixels<decltype(tag)::value>(frame, y, x0, x1); });
+  });
 }
 
 MarkerFrame marker_frame(const RectangleCandidate& red, const RectangleCandidate& green,
@@ -231,8 +235,8 @@ float dot_threshold_ratio(const DetectorParams& params, double blur_px, double r
 
 CodeReading read_code(const ImageView& frame, const MarkerFrame& marker, bool red,
                       const CeilingLayout& layout, const DetectorParams& params,
-                      float threshold_ratio, double search_m) {
-  if (search_m < 0.0) search_m = params.dot_search_m;
+                      float threshold_ratio, DotSearch search) {
+  const bool from_edges = search == DotSearch::kFromEdges;
   CodeReading out;
   const double e_m = red ? layout.red_centre_e_m() : layout.green_centre_e_m();
   const double dot_e_m = red ? layout.red_dot_e_m : layout.green_dot_e_m;
@@ -243,8 +247,10 @@ CodeReading read_code(const ImageView& frame, const MarkerFrame& marker, bool re
   for (int k = 0; k <= layout.bits; ++k) {
     const double n_m = layout.slot_n_m(0) + 0.5 * layout.slot_pitch_m - k * layout.slot_pitch_m;
     if (std::abs(n_m) > limit_n_m) continue;
-    const Brightness b = patch_brightness(frame, marker, e_m, n_m, reference_spread_e_m(layout),
-                                          kReferenceSpreadN * dot_n_m);
+    const Brightness b =
+        from_edges ? line_brightness(frame, marker, e_m, n_m, reference_spread_e_m(layout))
+                   : patch_brightness(frame, marker, e_m, n_m, reference_spread_e_m(layout),
+                                      kReferenceSpreadN * dot_n_m);
     if (b[0] < 0.0) return out;
     ref_sum[0] += b[0];
     ref_sum[1] += b[1];
@@ -253,6 +259,8 @@ CodeReading read_code(const ImageView& frame, const MarkerFrame& marker, bool re
   if (ref_count == 0) return out;
   const Brightness reference{ref_sum[0] / ref_count, ref_sum[1] / ref_count};
   if (reference[0] < 1.0 || reference[1] < 1.0) return out;
+  const double search_m =
+      from_edges ? std::min(params.dot_search_m, kEdgePlacedDotSearch_m) : params.dot_search_m;
   const double px_per_m = length_2d(marker.north_u, marker.north_v);
   // One pixel, or a sixth of the dot's height in large images.
   const double step_m = std::max(px_per_m > 0.0 ? 1.0 / px_per_m : search_m,

@@ -19,9 +19,6 @@ constexpr int kMaxRectangles = 256;
 // How far an edge-tracked marker may lie from its prediction, pixels, before
 // its edges are measured again around where they were found.
 constexpr double kRecentreEdges_px = 1.0;
-// How far along North an edge-tracked marker's dots are sought from their
-// slots (a whole sweep: detector.dot_search_m, 1 in).
-constexpr double kTrackedDotSearch_m = 0.25 * kInch_m;
 // Smallest red dot, pixels at the nominal height, for a halved sweep: 2.5
 // samples at half resolution (a 640x480 frame's are 6-7 px, a 320x240
 // one's 3 px).
@@ -106,7 +103,7 @@ bool Pipeline::usable(const ImageView& frame) const {
 // frame and its red rectangle's edges (a whole sweep's decode and an
 // edge-tracked frame's alike).
 PairOutcome Pipeline::read_codes(const ImageView& frame, const MarkerFrame& m,
-                                 const RectangleEdges& red_edges, double dot_search_m,
+                                 const RectangleEdges& red_edges, DotSearch search,
                                  CodeReading* code_i, CodeReading* code_j) const {
   const CeilingLayout& layout = config_.layout;
   // Blur first: it decides whether the dots can be read and where their
@@ -115,8 +112,8 @@ PairOutcome Pipeline::read_codes(const ImageView& frame, const MarkerFrame& m,
   const double blur_px = red_edges.spread_px;
   if (blur_px > config_.detector.max_blur_to_dot * red_dot_px) return PairOutcome::kBlurred;
   const float threshold = dot_threshold_ratio(config_.detector, blur_px, red_dot_px);
-  *code_i = read_code(frame, m, true, layout, config_.detector, threshold, dot_search_m);
-  *code_j = read_code(frame, m, false, layout, config_.detector, threshold, dot_search_m);
+  *code_i = read_code(frame, m, true, layout, config_.detector, threshold, search);
+  *code_j = read_code(frame, m, false, layout, config_.detector, threshold, search);
   if (!code_i->ok || !code_j->ok) return PairOutcome::kUnreadable;
   if (std::min(code_i->margin, code_j->margin) < config_.detector.dot_min_margin)
     return PairOutcome::kAmbiguous;
@@ -219,7 +216,7 @@ PairOutcome Pipeline::decode(const ImageView& frame, const MarkerPair& pair,
   const RectangleEdges red_edges = measure_edges(frame, m, true, layout);
   CodeReading code_i, code_j;
   const PairOutcome read =
-      read_codes(frame, m, red_edges, config_.detector.dot_search_m, &code_i, &code_j);
+      read_codes(frame, m, red_edges, DotSearch::kFromCentroids, &code_i, &code_j);
   if (read != PairOutcome::kDecoded) return read;
   if (!dark_area_consistent(red, code_i.code, true, layout, px_per_m) ||
       !dark_area_consistent(green, code_j.code, false, layout, px_per_m)) {
@@ -281,13 +278,10 @@ PairOutcome Pipeline::measure_at(const ImageView& frame, MarkerFrame m, MarkerOb
         length_2d(du, dv) > kRecentreEdges_px)
       return PairOutcome::kInconsistent;
   }
-  // The dots are then where the edges put them, to a pixel: their darkest
-  // line is sought over kTrackedDotSearch_m, not a whole sweep's
-  // dot_search_m (which allows for a frame fitted to blurred centroids).
+  // The dots are then where the edges put them, to a pixel (DotSearch::
+  // kFromEdges).
   CodeReading code_i, code_j;
-  const PairOutcome read =
-      read_codes(frame, m, red_edges, std::min(config_.detector.dot_search_m, kTrackedDotSearch_m),
-                 &code_i, &code_j);
+  const PairOutcome read = read_codes(frame, m, red_edges, DotSearch::kFromEdges, &code_i, &code_j);
   if (read != PairOutcome::kDecoded) return read;
   MarkerObservation& o = *out;
   o.code_i = code_i.code;

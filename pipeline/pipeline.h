@@ -151,7 +151,7 @@ class Pipeline {
   void position(PositioningMode mode, const CameraMotion& motion, FrameResult* out,
                 StageClock* clock);
   PairOutcome read_codes(const ImageView& frame, const MarkerFrame& m,
-                         const RectangleEdges& red_edges, double dot_search_m, CodeReading* code_i,
+                         const RectangleEdges& red_edges, DotSearch search, CodeReading* code_i,
                          CodeReading* code_j) const;
   PairOutcome decode(const ImageView& frame, const MarkerPair& pair, MarkerObservation* out);
   PairOutcome measure_at(const ImageView& frame, MarkerFrame m, MarkerObservation* out);

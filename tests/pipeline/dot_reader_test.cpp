@@ -119,6 +119,50 @@ TEST_F(DotReaderTest, YuyvReadsExactlyAsItsPixelsRgb) {
   }
 }
 
+// A marker frame its edges placed is within a pixel of the marker
+// (Pipeline::measure_at recentres it beyond one). Read from its edges (dots
+// sought ±0.25 in, one reference line a patch), every code of noisy
+// markers at any rotation, the frame up to 0.7 px off either way, reads
+// back with the margin a reading from centroids has, to within the noise.
+TEST_F(DotReaderTest, FromEdgesReadsEveryCodeOfAFramePlacedWithinAPixel) {
+  std::mt19937 rng(31);
+  std::uniform_int_distribution<int> noise(-6, 6);
+  std::uniform_real_distribution<double> unit(-1.0, 1.0);
+  float worst_margin = 1.0f, worst_margin_gap = 0.0f;
+  for (int k = 0; k < 64; ++k) {
+    test::CraftedMarker m;
+    m.centre_u_px = 160.0 + 0.5 * unit(rng);
+    m.centre_v_px = 120.0 + 0.5 * unit(rng);
+    m.code_i = k % layout.codes();
+    m.code_j = (k / layout.codes()) % layout.codes();
+    m.west_image_rad = std::numbers::pi * unit(rng);
+    Image scene = test::render_markers(320, 240, std::span(&m, 1), layout);
+    for (int y = 0; y < scene.height(); ++y) {
+      for (int x = 0; x < 3 * scene.width(); ++x) {
+        uint8_t& level = scene.row(y)[x];
+        level = static_cast<uint8_t>(std::clamp(level + noise(rng), 0, 255));
+      }
+    }
+    MarkerFrame f = frame_of(m, layout);
+    f.centre_u_px += 0.7 * unit(rng);
+    f.centre_v_px += 0.7 * unit(rng);
+    for (bool red : {true, false}) {
+      const CodeReading edges = read_code(scene.view(), f, red, layout, params,
+                                          params.dot_threshold_ratio, DotSearch::kFromEdges);
+      const CodeReading centroids =
+          read_code(scene.view(), f, red, layout, params, params.dot_threshold_ratio);
+      ASSERT_TRUE(edges.ok && centroids.ok) << k;
+      EXPECT_EQ(edges.code, red ? m.code_i : m.code_j) << k << (red ? " red" : " green");
+      worst_margin = std::min(worst_margin, edges.margin);
+      worst_margin_gap = std::max(worst_margin_gap, std::abs(edges.margin - centroids.margin));
+    }
+  }
+  std::printf("[dots] from edges: smallest margin %.3f, largest gap to centroids' %.3f\n",
+              worst_margin, worst_margin_gap);
+  EXPECT_GT(worst_margin, 0.2f);
+  EXPECT_LT(worst_margin_gap, 0.1f);
+}
+
 TEST_F(DotReaderTest, SingleDotInTheNorthSlotIsTheMostSignificantBit) {
   test::CraftedMarker m;
   m.centre_u_px = 160.2;
@@ -348,6 +392,21 @@ TEST(MarkerRegion, SpansEveryPixelABilinearReadInsideTouchesAndLittleElse) {
       ++rows;
     }
     EXPECT_LE(spanned_px, padded_px + 3.0 * rows) << "trial " << trial;
+    // What ask_marker_region walks: the same rows, each from the same
+    // column to the same or the next.
+    int walked = 0, spans = 0;
+    region.for_each_span([&](int y, int x0, int x1) {
+      ++walked;
+      const PixelSpan span = region.row(y);
+      EXPECT_EQ(x0, span.x0) << "trial " << trial << " row " << y;
+      EXPECT_GE(x1, span.x1) << "trial " << trial << " row " << y;
+      EXPECT_LE(x1, span.x1 + 1) << "trial " << trial << " row " << y;
+    });
+    for (int y = region.first_row(); y <= region.last_row(); ++y) {
+      const PixelSpan span = region.row(y);
+      spans += span.x0 <= span.x1 ? 1 : 0;
+    }
+    EXPECT_EQ(walked, spans) << "trial " << trial;
   }
 }
 
