@@ -43,7 +43,7 @@ LsqNormal LsqCovariance::placement_information(
     // evidence of how far off their places the markers are.
     const double w = !use[pt.fix] ? 0.0 : r <= k ? 1.0 : k / r;
     double jx[kN], jy[kN];
-    point_jacobian(view, pt, cam, jx, jy, model.tilt_free());
+    point_jacobian(view, pt, cam, jx, jy, model.tilt_free(), model.motion_free());
     // A marker shift moves its points as a camera shift the other way; its
     // rotation moves a point at (dx, dy) from the centre by (−dy, dx)·dθ.
     const MarkerFix& fix = fixes[pt.fix];

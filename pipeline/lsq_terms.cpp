@@ -132,7 +132,7 @@ bool point_residual(const ViewGeometry& view, const LsqPoint& pt, const PointCam
 // v and w move it as t and the yaw do, tau times as much, and each also
 // turns the other's share of the arc.
 void point_jacobian(const ViewGeometry& view, const LsqPoint& pt, const PointCamera& cam,
-                    double* jx, double* jy, bool with_tilt) {
+                    double* jx, double* jy, bool with_tilt, bool with_motion) {
   const double fx = view.intrinsics().fx, fy = view.intrinsics().fy;
   const Vec3& d = cam.d;
   const Vec3 p = mat_vec(cam.rt, d);
@@ -159,13 +159,22 @@ void point_jacobian(const ViewGeometry& view, const LsqPoint& pt, const PointCam
   }
   const double t = pt.tau_s, half_t2 = 0.5 * t * t, turn = cam.w_radps * half_t2;
   for (double* j : {jx, jy}) {
+    if (!with_motion) {
+      j[kLsqVx] = j[kLsqVy] = j[kLsqYawRate] = 0.0;
+      continue;
+    }
     j[kLsqVx] = t * j[kLsqTx] + turn * j[kLsqTy];
     j[kLsqVy] = t * j[kLsqTy] - turn * j[kLsqTx];
     j[kLsqYawRate] = t * j[kLsqYaw] + half_t2 * (cam.vx_mps * j[kLsqTy] - cam.vy_mps * j[kLsqTx]);
   }
   jx[kLsqEdgeOffset] = jy[kLsqEdgeOffset] = 0.0;
   if (!pt.is_edge()) return;
-  for (int c = 0; c < kN; ++c) across_edge(pt, 0.0, cam.edge_weight, &jx[c], &jy[c]);
+  // Across the edge: the columns left zero stay zero.
+  for (int c = 0; c < kN; ++c) {
+    const bool zero = (!with_tilt && (c == kLsqTiltX || c == kLsqTiltY)) ||
+                      (!with_motion && (c == kLsqVx || c == kLsqVy || c == kLsqYawRate));
+    if (!zero) across_edge(pt, 0.0, cam.edge_weight, &jx[c], &jy[c]);
+  }
   jx[kLsqEdgeOffset] = -cam.edge_weight;
 }
 
@@ -209,7 +218,7 @@ double accumulate(const ViewGeometry& view, const PositioningParams& params,
     n += pt.residuals();
     if (!with_jacobian) continue;
     double jx[kN], jy[kN];
-    point_jacobian(view, pt, cam, jx, jy, model.tilt_free());
+    point_jacobian(view, pt, cam, jx, jy, model.tilt_free(), model.motion_free());
     if (pt.is_edge()) {
       // One residual, across the edge (ry and jy are zero): half the terms.
       for (int i = 0; i < free_n; ++i) {

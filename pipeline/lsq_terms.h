@@ -102,10 +102,11 @@ bool point_residual(const ViewGeometry& view, const LsqPoint& pt, const PointCam
                     double* rx, double* ry);
 
 // Jacobian of the pixel residual with respect to every unknown (LsqParam
-// order), motion columns included; without with_tilt the two tilt columns
-// are left zero (a fit that holds the tilt, most fits, never reads them).
+// order); without with_tilt the two tilt columns, without with_motion the
+// three motion columns are left zero (a fit that holds them, most fits,
+// never reads them).
 void point_jacobian(const ViewGeometry& view, const LsqPoint& pt, const PointCamera& cam,
-                    double* jx, double* jy, bool with_tilt = true);
+                    double* jx, double* jy, bool with_tilt = true, bool with_motion = true);
 
 // Squared reprojection residual of one point, pixels².
 double residual2_px(const ViewGeometry& view, const LsqState& st, const LsqPoint& pt);

@@ -4,6 +4,7 @@
 
 #include <cmath>
 
+#include "pipeline/lsq_terms.h"
 #include "pipeline/pipeline_config.h"
 #include "pipeline/positioner.h"
 #include "positioning_support.h"
@@ -13,6 +14,44 @@ namespace {
 
 double position_error_m(const PoseEstimate& est, const Pose2D& truth) {
   return std::hypot(est.pose.x_m - truth.x_m, est.pose.y_m - truth.y_m);
+}
+
+// A fit that holds the tilt or the motion never reads their columns: left
+// out, they are zero, and every other column is what the whole Jacobian
+// gives, for a centroid and for an edge point under a moving rolling
+// shutter.
+TEST(PointJacobian, ColumnsLeftOutAreZeroAndTheOthersUnchanged) {
+  PipelineConfig config;
+  const ViewGeometry view(config);
+  LsqState st;
+  st.t_w = {2.0, 2.0, 0.3};
+  st.r_wc = {0.0, -1.0, 0.0, 1.0, 0.0, 0.0, 0.0, 0.0, 1.0};
+  st.vx = 0.8, st.vy = -0.3, st.w = 0.6;
+  st.edge_weight = 1.7;
+  const PointCamera centre = centre_camera(st);
+  for (const bool edge : {false, true}) {
+    LsqPoint pt{0.05, 0.04, {2.1, 2.08, 2.4384}, 0, 0.004};
+    if (edge) pt.normal_x = 0.6, pt.normal_y = 0.8;
+    const PointCamera cam = point_camera(st, pt, centre, true);
+    double all_x[kLsqParams], all_y[kLsqParams];
+    point_jacobian(view, pt, cam, all_x, all_y, true, true);
+    for (const bool tilt : {false, true}) {
+      for (const bool motion : {false, true}) {
+        double jx[kLsqParams], jy[kLsqParams];
+        point_jacobian(view, pt, cam, jx, jy, tilt, motion);
+        for (int c = 0; c < kLsqParams; ++c) {
+          const bool left_out = (!tilt && (c == kLsqTiltX || c == kLsqTiltY)) ||
+                                (!motion && (c == kLsqVx || c == kLsqVy || c == kLsqYawRate));
+          EXPECT_EQ(jx[c], left_out ? 0.0 : all_x[c]) << edge << tilt << motion << " column " << c;
+          EXPECT_EQ(jy[c], left_out ? 0.0 : all_y[c]) << edge << tilt << motion << " column " << c;
+          // The columns left out are not zero in the whole Jacobian.
+          if (c >= kLsqTiltX && c <= kLsqYawRate && c != kLsqTz) {
+            EXPECT_NE(all_x[c], 0.0) << edge << " column " << c;
+          }
+        }
+      }
+    }
+  }
 }
 
 TEST(LeastSquares, RecoversExactPose) {
