@@ -60,8 +60,8 @@ class MarkerRegion {
   }
   // Calls fn(y, x0, x1) for each row from first_row() to last_row() whose
   // span row(y) is not empty: its x0, and its x1 or one more (truncated
-  // rather than rounded up: ~25 instructions a row instead of ~45, for
-  // prefetching).
+  // rather than rounded up, for prefetching: docs/pipeline_speed.md,
+  // session 43).
   template <typename Fn>
   void for_each_span(Fn fn) const {
     const Bound& a = bounds_[0];
@@ -120,10 +120,11 @@ enum class DotSearch {
   // darkest line within ±params.dot_search_m along North of its slot,
   // against reference patches of 3 × 3 points.
   kFromCentroids,
-  // Its edges, to a pixel (tracked frames, halved sweeps): within ±0.25 in,
-  // against reference patches of one line of three points across the
-  // rectangle (the patches' ±0.1 dot heights along North are under a pixel
-  // at 640×480: 12 of a red rectangle's 45 samples).
+  // Its edges, to a pixel (tracked frames, halved sweeps): within a
+  // quarter inch (dot_reader.cpp's kEdgePlacedDotSearch_m), against
+  // reference patches of one line of three points across the rectangle
+  // (a patch's ±0.1 dot heights along North are under a pixel at 640×480;
+  // its two rows more were 12 of a red rectangle's 45 samples).
   kFromEdges,
 };
 
