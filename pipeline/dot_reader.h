@@ -46,16 +46,12 @@ class MarkerRegion {
   int last_row() const { return last_row_; }
   // Inline: a tracked 1280x960 frame asks for ~3000 rows.
   PixelSpan row(int y) const {
-    const double dv = y - centre_v_px_;
-    const Bound& a = bounds_[0];
-    const Bound& b = bounds_[1];
-    const double du_lo = std::max(a.lo_px + dv * a.slope, b.lo_px + dv * b.slope);
-    const double du_hi = std::min(a.hi_px + dv * a.slope, b.hi_px + dv * b.slope);
+    double u_lo = 0.0, u_hi = 0.0;
     PixelSpan out;
-    if (!(du_lo <= du_hi)) return out;
+    if (!columns(y, &u_lo, &u_hi)) return out;
     // Clamped first: a span beyond the frame comes out empty (x0 > x1).
-    out.x0 = floor_int(std::clamp(centre_u_px_ + du_lo, 0.0, static_cast<double>(width_)));
-    out.x1 = ceil_int(std::clamp(centre_u_px_ + du_hi, -1.0, width_ - 1.0));
+    out.x0 = floor_int(std::clamp(u_lo, 0.0, static_cast<double>(width_)));
+    out.x1 = ceil_int(std::clamp(u_hi, -1.0, width_ - 1.0));
     return out;
   }
   // Calls fn(y, x0, x1) for each row from first_row() to last_row() whose
@@ -64,15 +60,10 @@ class MarkerRegion {
   // session 43).
   template <typename Fn>
   void for_each_span(Fn fn) const {
-    const Bound& a = bounds_[0];
-    const Bound& b = bounds_[1];
     const double width = width_, last_x = width_ - 1.0;
     for (int y = first_row_; y <= last_row_; ++y) {
-      const double dv = y - centre_v_px_;
-      const double du_lo = std::max(a.lo_px + dv * a.slope, b.lo_px + dv * b.slope);
-      const double du_hi = std::min(a.hi_px + dv * a.slope, b.hi_px + dv * b.slope);
-      const double lo = centre_u_px_ + du_lo, hi = centre_u_px_ + du_hi;
-      if (!(du_lo <= du_hi) || !(hi > -1.0) || !(lo < width)) continue;
+      double lo = 0.0, hi = 0.0;
+      if (!columns(y, &lo, &hi) || !(hi > -1.0) || !(lo < width)) continue;
       // Both in [0, width − 1]: truncation is the floor.
       const int x0 = static_cast<int>(std::clamp(lo, 0.0, last_x));
       const int x1 = std::min(static_cast<int>(std::clamp(hi, 0.0, last_x)) + 1, width_ - 1);
@@ -89,6 +80,18 @@ class MarkerRegion {
   struct Bound {
     double lo_px = -INFINITY, hi_px = INFINITY, slope = 0.0;
   };
+  // The columns [*u_lo, *u_hi] of row y within both bounds, unclamped;
+  // false when none (NaN bounds included).
+  bool columns(int y, double* u_lo, double* u_hi) const {
+    const double dv = y - centre_v_px_;
+    const Bound& a = bounds_[0];
+    const Bound& b = bounds_[1];
+    const double du_lo = std::max(a.lo_px + dv * a.slope, b.lo_px + dv * b.slope);
+    const double du_hi = std::min(a.hi_px + dv * a.slope, b.hi_px + dv * b.slope);
+    *u_lo = centre_u_px_ + du_lo;
+    *u_hi = centre_u_px_ + du_hi;
+    return du_lo <= du_hi;
+  }
   double centre_u_px_ = 0.0, centre_v_px_ = 0.0;
   std::array<Bound, 2> bounds_{};
   int width_ = 0;
