@@ -173,6 +173,24 @@ bool byte_plane(const ImageView& frame, EdgeChannel channel, BytePlane* out) {
   return true;
 }
 
+// What every profile of one rectangle reads: the frame, the marker frame
+// placing it, what its edges are measured in, and the byte plane of its
+// edge level where there is one (found once a rectangle, not once a
+// profile: ~50 instructions a profile).
+struct EdgeReading {
+  const ImageView& frame;
+  const MarkerFrame& marker;
+  EdgeLevels levels;
+  EdgeChannel channel;
+  BytePlane plane;
+  bool has_plane = false;
+
+  EdgeReading(const ImageView& f, const MarkerFrame& m, EdgeLevels l, EdgeChannel c)
+      : frame(f), marker(m), levels(l), channel(c) {
+    has_plane = byte_plane(f, c, &plane);
+  }
+};
+
 // The same for a kLinearLight profile over axis_steps, and its linear
 // light. Each step moves one whole pixel along the dominant axis, so the
 // bilinear weights along it are the same for every sample: the profile is
@@ -227,12 +245,13 @@ bool read_axis_profile(const ImageView& frame, const MarkerFrame& marker, double
 // A kLinearLight profile's levels: from a byte plane, four bytes at fixed
 // offsets per sample; else (RGB whose chroma was halved: its luma) each
 // pixel's level computed.
-bool read_linear_profile(const ImageView& frame, const MarkerFrame& marker, double e_m, double n_m,
-                         double de, double dn, const ProfileSteps& steps, EdgeChannel channel,
-                         double* level, double* edge) {
-  if (BytePlane plane; byte_plane(frame, channel, &plane)) {
+bool read_linear_profile(const EdgeReading& r, double e_m, double n_m, double de, double dn,
+                         const ProfileSteps& steps, double* level, double* edge) {
+  const ImageView& frame = r.frame;
+  if (r.has_plane) {
+    const BytePlane& plane = r.plane;
     return read_axis_profile(
-        frame, marker, e_m, n_m, de, dn, steps, *plane.table,
+        frame, r.marker, e_m, n_m, de, dn, steps, *plane.table,
         [&](bool u_major, int a, int b) {
           const ptrdiff_t major_bytes = u_major ? plane.pixel_bytes : plane.row_bytes;
           const ptrdiff_t minor_bytes = u_major ? plane.row_bytes : plane.pixel_bytes;
@@ -247,11 +266,11 @@ bool read_linear_profile(const ImageView& frame, const MarkerFrame& marker, doub
   with_pixel_format(frame.format, [&](auto tag) {
     constexpr PixelFormat F = decltype(tag)::value;
     inside = read_axis_profile(
-        frame, marker, e_m, n_m, de, dn, steps, *identity.table,
+        frame, r.marker, e_m, n_m, de, dn, steps, *identity.table,
         [&](bool u_major, int a, int b) {
           auto read = [&](int major_px, int minor_px) {
-            return u_major ? pixel_edge_level<F>(frame, major_px, minor_px, channel)
-                           : pixel_edge_level<F>(frame, minor_px, major_px, channel);
+            return u_major ? pixel_edge_level<F>(frame, major_px, minor_px, r.channel)
+                           : pixel_edge_level<F>(frame, minor_px, major_px, r.channel);
           };
           return std::array<uint8_t, 4>{read(a, b), read(a + 1, b), read(a, b + 1),
                                         read(a + 1, b + 1)};
@@ -264,30 +283,30 @@ bool read_linear_profile(const ImageView& frame, const MarkerFrame& marker, doub
 // One profile through marker point (e_m, n_m) on the edge along the unit
 // marker-frame direction (de, dn), pointing out of the rectangle. False when
 // it leaves the frame or the contrast is too low.
-bool profile(const ImageView& frame, const MarkerFrame& marker, double e_m, double n_m, double de,
-             double dn, const ProfileSteps& steps, EdgeLevels levels, EdgeChannel channel,
-             bool with_spread, Crossings* out) {
+bool profile(const EdgeReading& r, double e_m, double n_m, double de, double dn,
+             const ProfileSteps& steps, bool with_spread, Crossings* out) {
   const int samples = steps.samples;
   const double step_m = steps.step_m;
   // Levels (contrast, blur) and what the edge is measured in (the darkest
   // level itself, or the channel's linear light).
   std::array<double, kMaxSamples> level, edge;
   bool inside = false;
-  if (levels == EdgeLevels::kDarkestLevel) {
-    inside = read_fitted_profile(frame, marker, e_m, n_m, de, dn, steps, level.data());
+  if (r.levels == EdgeLevels::kDarkestLevel) {
+    inside = read_fitted_profile(r.frame, r.marker, e_m, n_m, de, dn, steps, level.data());
     edge = level;
   } else {
-    inside = read_linear_profile(frame, marker, e_m, n_m, de, dn, steps, channel, level.data(),
-                                 edge.data());
+    inside = read_linear_profile(r, e_m, n_m, de, dn, steps, level.data(), edge.data());
   }
   if (!inside) return false;
   const double low = 0.5 * (level[0] + level[1]);
   const double high = 0.5 * (level[samples - 1] + level[samples - 2]);
   if (high - low < kMinContrast) return false;
-  // The first upward crossing of a share of the rise: of 25, 50 and 75 %
-  // with the spread, of 50 % alone without (a long side's: only the ends'
-  // spread is the marker's blur). Each share scans only up to its own
-  // crossing: 1297 → 1207 instructions a profile (640×480 YUYV drive).
+  // The first upward crossing of a share of the rise: of 25 and 75 % for
+  // the spread (only the ends': a long side's is not the marker's blur).
+  // Each share scans only up to its own crossing. Every share between 0 and
+  // 1 is crossed: low and high are means of two end samples, so one of
+  // level[0..1] lies at or below low and one of the last two at or above
+  // high, after it.
   auto first_crossing = [&](double share) {
     const double target = low + share * (high - low);
     for (int k = 1; k < samples; ++k) {
@@ -297,21 +316,19 @@ bool profile(const ImageView& frame, const MarkerFrame& marker, double e_m, doub
     }
     return static_cast<double>(NAN);
   };
-  const std::array<double, 3> at{with_spread ? first_crossing(0.25) : 0.0, first_crossing(0.5),
-                                 with_spread ? first_crossing(0.75) : 0.0};
   if (with_spread) {
-    out->at25 = at[0];
-    out->at75 = at[2];
+    out->at25 = first_crossing(0.25);
+    out->at75 = first_crossing(0.75);
   }
   // The edge: where a sharp step with the profile's area would be (the
   // rise's shortfall summed from the inner end), so every sample counts
   // rather than the two around the half-way level: on tilted independent
   // renders p99 1.3-1.8 mm against 1.3-2.4 mm by the half-way crossing.
-  // Only a profile that rises through half-way, and not into the sensor's
-  // ceiling: a clipped rise is no longer symmetric about the edge, and its
-  // shift varies with the edge's angle (a level frame of a +1.9 EV
-  // render chose a tilt and was 2.8 mm off).
-  if (std::isnan(at[1]) || high >= kClipLevel) return true;
+  // Not a rise into the sensor's ceiling: a clipped rise is no longer
+  // symmetric about the edge, and its shift varies with the edge's angle (a
+  // level frame of a +1.9 EV render chose a tilt and was 2.8 mm off). (It
+  // rises through half-way, as through every share: above.)
+  if (high >= kClipLevel) return true;
   // Under kLinearLight the area is summed in linear light: a pixel
   // straddling the edge holds the area-weighted mean of the two sides'
   // light, which its sRGB level does not (half covered, it reads ~70 % of
@@ -338,10 +355,10 @@ bool profile(const ImageView& frame, const MarkerFrame& marker, double e_m, doub
 // (de, dn), from parallel profiles at `fractions` of `offset_m` along it;
 // *spread_m, unless null: their mean 25–75 % distance (NaN: not measured).
 template <size_t N>
-EdgeCrossing cross_edge(const ImageView& frame, const MarkerFrame& marker, double e_m, double n_m,
-                        double de, double dn, double offset_m,
-                        const std::array<double, N>& fractions, const ProfileSteps& steps,
-                        EdgeLevels levels, EdgeChannel channel, double* spread_m) {
+EdgeCrossing cross_edge(const EdgeReading& r, double e_m, double n_m, double de, double dn,
+                        double offset_m, const std::array<double, N>& fractions,
+                        const ProfileSteps& steps, double* spread_m) {
+  const MarkerFrame& marker = r.marker;
   EdgeCrossing out;
   double spread_sum_m = 0.0;
   int spreads = 0;
@@ -352,8 +369,7 @@ EdgeCrossing cross_edge(const ImageView& frame, const MarkerFrame& marker, doubl
     const double along_m = fraction * offset_m;
     const double pe = e_m - along_m * dn, pn = n_m + along_m * de;
     Crossings c;
-    if (!profile(frame, marker, pe, pn, de, dn, steps, levels, channel, spread_m != nullptr, &c))
-      continue;
+    if (!profile(r, pe, pn, de, dn, steps, spread_m != nullptr, &c)) continue;
     if (!std::isnan(c.at25) && !std::isnan(c.at75)) {
       spread_sum_m += c.at75 - c.at25;
       ++spreads;
@@ -386,19 +402,17 @@ EdgeCrossing cross_edge(const ImageView& frame, const MarkerFrame& marker, doubl
 
 // One edge under `levels`: two profiles over fitted steps, or four over
 // axis steps.
-EdgeCrossing measure_edge(const ImageView& frame, const MarkerFrame& marker, double e_m, double n_m,
-                          double de, double dn, double offset_m, int fitted_samples,
-                          EdgeLevels levels, EdgeChannel channel, double* spread_m) {
-  if (levels == EdgeLevels::kDarkestLevel)
-    return cross_edge(frame, marker, e_m, n_m, de, dn, offset_m, kTwoProfiles,
-                      fitted_steps(fitted_samples), levels, channel, spread_m);
-  const ProfileSteps steps = axis_steps(marker, de, dn);
+EdgeCrossing measure_edge(const EdgeReading& r, double e_m, double n_m, double de, double dn,
+                          double offset_m, int fitted_samples, double* spread_m) {
+  if (r.levels == EdgeLevels::kDarkestLevel)
+    return cross_edge(r, e_m, n_m, de, dn, offset_m, kTwoProfiles, fitted_steps(fitted_samples),
+                      spread_m);
+  const ProfileSteps steps = axis_steps(r.marker, de, dn);
   if (steps.samples == 0) {
     if (spread_m != nullptr) *spread_m = NAN;
     return {};
   }
-  return cross_edge(frame, marker, e_m, n_m, de, dn, offset_m, kFourProfiles, steps, levels,
-                    channel, spread_m);
+  return cross_edge(r, e_m, n_m, de, dn, offset_m, kFourProfiles, steps, spread_m);
 }
 
 }  // namespace
@@ -412,6 +426,7 @@ RectangleEdges measure_edges(const ImageView& frame, const MarkerFrame& marker, 
                                                   : EdgeChannel::kRed;
   const double px_per_m = length_2d(marker.north_u, marker.north_v);
   if (!(px_per_m > 0.0)) return out;
+  const EdgeReading reading(frame, marker, levels, channel);
   const int samples =
       std::clamp(static_cast<int>(2.0 * kEdgeProfileHalf_m * px_per_m) + 1, 5, kMaxSamples);
   double spread_sum_m = 0.0;
@@ -420,8 +435,8 @@ RectangleEdges measure_edges(const ImageView& frame, const MarkerFrame& marker, 
     const double dn = s == 0 ? 1.0 : -1.0;
     double spread_m = NAN;
     out.end[static_cast<size_t>(s)] =
-        measure_edge(frame, marker, centre_e_m, dn * 0.5 * layout.rect_height_m, 0.0, dn,
-                     kEndProfileOffset_m, samples, levels, channel, &spread_m);
+        measure_edge(reading, centre_e_m, dn * 0.5 * layout.rect_height_m, 0.0, dn,
+                     kEndProfileOffset_m, samples, &spread_m);
     if (std::isnan(spread_m)) continue;
     spread_sum_m += spread_m;
     ++spreads;
@@ -431,8 +446,8 @@ RectangleEdges measure_edges(const ImageView& frame, const MarkerFrame& marker, 
   const double de = red ? 1.0 : -1.0;
   for (int k = 0; k + 1 < layout.bits && out.side_count < kMaxSideCrossings; ++k) {
     const double n_m = 0.5 * (layout.slot_n_m(k) + layout.slot_n_m(k + 1));
-    const EdgeCrossing c = measure_edge(frame, marker, de * layout.rect_width_m, n_m, de, 0.0,
-                                        kSideProfileOffset_m, samples, levels, channel, nullptr);
+    const EdgeCrossing c = measure_edge(reading, de * layout.rect_width_m, n_m, de, 0.0,
+                                        kSideProfileOffset_m, samples, nullptr);
     if (c.found) out.side[static_cast<size_t>(out.side_count++)] = c;
   }
   return out;
