@@ -23,8 +23,9 @@ constexpr int kN = kLsqParams;
 // leaves them (K >= 2 markers).
 LsqNormal LsqCovariance::placement_information(
     const ViewGeometry& view, const PositioningParams& params, std::span<const LsqPoint> points,
-    std::span<const MarkerFix> fixes, std::span<const bool> consistent, std::span<const bool> use,
-    const LsqState& st, const LsqModel& model) {
+    std::span<const PointTerms> terms, std::span<const MarkerFix> fixes,
+    std::span<const bool> consistent, std::span<const bool> use, const LsqState& st,
+    const LsqModel& model) {
   const double k = params.lsq_huber_px;
   // Only the free unknowns' rows: the covariance reads M through
   // (J^T W J)^-1, whose other rows are zero.
@@ -33,17 +34,28 @@ LsqNormal LsqCovariance::placement_information(
   const PointCamera centre = centre_camera(st);
   const int n_fix = static_cast<int>(fixes.size());
   for (int f = 0; f < n_fix; ++f) marker_terms_[f] = MarkerTerm{};
-  for (const LsqPoint& pt : points) {
+  for (size_t i = 0; i < points.size(); ++i) {
+    const LsqPoint& pt = points[i];
     if (!consistent[pt.fix]) continue;
-    const PointCamera cam = point_camera(st, pt, centre, true);
     double rx = 0.0, ry = 0.0;
-    if (!point_residual(view, pt, cam, &rx, &ry)) continue;
+    double own_jx[kN], own_jy[kN];
+    const double* jx = own_jx;
+    const double* jy = own_jy;
+    // A point in use: as the fit's last accumulate found it at st (its
+    // Jacobian's columns this model leaves out may be filled: only the
+    // free unknowns' are read).
+    if (!terms.empty() && terms[i].kept) {
+      rx = terms[i].rx, ry = terms[i].ry;
+      jx = terms[i].jx, jy = terms[i].jy;
+    } else {
+      const PointCamera cam = point_camera(st, pt, centre, true);
+      if (!point_residual(view, pt, cam, &rx, &ry)) continue;
+      point_jacobian(view, pt, cam, own_jx, own_jy, model.tilt_free(), model.motion_free());
+    }
     const double r = std::sqrt(rx * rx + ry * ry);
     // Markers the solve rejected carry no weight in the pose but are
     // evidence of how far off their places the markers are.
     const double w = !use[pt.fix] ? 0.0 : r <= k ? 1.0 : k / r;
-    double jx[kN], jy[kN];
-    point_jacobian(view, pt, cam, jx, jy, model.tilt_free(), model.motion_free());
     // A marker shift moves its points as a camera shift the other way; its
     // rotation moves a point at (dx, dy) from the centre by (−dy, dx)·dθ.
     const MarkerFix& fix = fixes[pt.fix];
@@ -104,12 +116,13 @@ LsqNormal LsqCovariance::placement_information(
 // plus the configured floors.
 bool LsqCovariance::robot_covariance(const ViewGeometry& view, const PositioningParams& params,
                                      const LsqModel& model, std::span<const LsqPoint> points,
+                                     std::span<const PointTerms> terms,
                                      std::span<const MarkerFix> fixes,
                                      std::span<const bool> consistent, std::span<const bool> use,
                                      const LsqState& st, const LsqNormal& a, double wr2, int n,
                                      const Pose2D& robot, std::array<double, 9>* out) {
   const LsqNormal placement =
-      placement_information(view, params, points, fixes, consistent, use, st, model);
+      placement_information(view, params, points, terms, fixes, consistent, use, st, model);
   const double dof = std::max(1, n - model.free_count());
   const double sigma2 = wr2 / dof;
   // g = the first three columns of (J^T W J)^-1.

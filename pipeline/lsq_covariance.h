@@ -19,16 +19,21 @@ class LsqCovariance {
   // `st` with normal equations `a` (priors included) and the Huber-weighted
   // squared residuals wr2 of n residuals. `consistent`: the markers grid
   // consistency kept (the solve may have rejected some of them since), `use`:
-  // those the solve kept. False when the normal equations are singular.
+  // those the solve kept. `terms`: what the accumulate that gave `a` kept
+  // of each point at `st` (empty: none; else at least one a point). False
+  // when the normal equations
+  // are singular.
   bool robot_covariance(const ViewGeometry& view, const PositioningParams& params,
                         const LsqModel& model, std::span<const LsqPoint> points,
-                        std::span<const MarkerFix> fixes, std::span<const bool> consistent,
-                        std::span<const bool> use, const LsqState& st, const LsqNormal& a,
-                        double wr2, int n, const Pose2D& robot, std::array<double, 9>* out);
+                        std::span<const PointTerms> terms, std::span<const MarkerFix> fixes,
+                        std::span<const bool> consistent, std::span<const bool> use,
+                        const LsqState& st, const LsqNormal& a, double wr2, int n,
+                        const Pose2D& robot, std::array<double, 9>* out);
 
  private:
   LsqNormal placement_information(const ViewGeometry& view, const PositioningParams& params,
                                   std::span<const LsqPoint> points,
+                                  std::span<const PointTerms> terms,
                                   std::span<const MarkerFix> fixes,
                                   std::span<const bool> consistent, std::span<const bool> use,
                                   const LsqState& st, const LsqModel& model);

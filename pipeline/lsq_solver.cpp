@@ -16,6 +16,10 @@ constexpr double kTiltScoreShare = 0.25;
 
 }  // namespace
 
+LsqSolver::LsqSolver() {
+  for (std::vector<PointTerms>& slot : terms_) slot.resize(points_.size());
+}
+
 const char* to_string(TiltChoice choice) {
   switch (choice) {
     case TiltChoice::kNotAllowed:
@@ -61,8 +65,9 @@ bool LsqSolver::solve(const ViewGeometry& view, const PositioningParams& params,
   // 4. The covariance.
   out->robot =
       view.robot_from_camera(fit.state.t_w[0], fit.state.t_w[1], camera_yaw_of(fit.state.r_wc));
-  if (!covariance_.robot_covariance(view, params, fit.model, points(), fixes, use, kept, fit.state,
-                                    fit.a, fit.wr2, n, out->robot, &out->covariance))
+  if (!covariance_.robot_covariance(view, params, fit.model, points(), terms(fit.terms_slot), fixes,
+                                    use, kept, fit.state, fit.a, fit.wr2, n, out->robot,
+                                    &out->covariance))
     return false;
   out->rms_px = rms;
   out->markers = fit.markers;
@@ -172,7 +177,11 @@ LsqSolver::Fit LsqSolver::choose_tilt_model(const ViewGeometry& view,
                                             const PositioningParams& params,
                                             std::span<const MarkerFix> fixes, const Fit& seed,
                                             int* iterations, LsqResult* out) {
+  // Each fit's trials trade slots with trial_slot_ alone: slot 1 stays the
+  // free fit's while the held fit is optimised.
   Fit held = seed;
+  held.terms_slot = 0;
+  trial_slot_ = 2;
   held.want_tilt_columns = params.lsq_estimate_tilt && seed.markers >= params.lsq_tilt_min_markers;
   optimise(view, params, fixes, &held, iterations);
   if (reweigh_edges(view, &held)) optimise(view, params, fixes, &held, iterations);
@@ -194,6 +203,7 @@ LsqSolver::Fit LsqSolver::choose_tilt_model(const ViewGeometry& view,
   // seed is (fewer iterations), with the seed's markers: the free model
   // makes its own rejections.
   Fit free = seed;
+  free.terms_slot = 1;
   if (std::isfinite(held.cost)) free.state = held.state;
   free.state.edge_weight = held.state.edge_weight;
   free.model.active[kLsqTiltX] = free.model.active[kLsqTiltY] = true;
@@ -288,7 +298,7 @@ double LsqSolver::position_sigma_m(const LsqModel& model, const LsqNormal& a, do
 // lsq_max_rejections times. Leaves fit->cost infinite when the solve
 // diverged.
 void LsqSolver::optimise(const ViewGeometry& view, const PositioningParams& params,
-                         std::span<const MarkerFix> fixes, Fit* fit, int* iterations) const {
+                         std::span<const MarkerFix> fixes, Fit* fit, int* iterations) {
   constexpr int kN = kLsqParams;
   constexpr double kLambdaStart = 1e-4;
   // A step's predicted gain, as a share of the cost, below which the fit
@@ -313,7 +323,8 @@ void LsqSolver::optimise(const ViewGeometry& view, const PositioningParams& para
     LsqModel columns = fit->model;
     if (fit->want_tilt_columns) columns.active[kLsqTiltX] = columns.active[kLsqTiltY] = true;
     bool tilt_columns = false;
-    double cost = accumulate(view, params, points(), use, st, fit->model, true, &a, &b, &wr2, &n) +
+    double cost = accumulate(view, params, points(), use, st, fit->model, true, &a, &b, &wr2, &n,
+                             terms(fit->terms_slot)) +
                   prior_cost(view, params, fit->model, st, &a, &b);
     if (!std::isfinite(cost)) return;
     for (int it = 0; it < params.lsq_max_iterations; ++it, ++*iterations) {
@@ -335,10 +346,12 @@ void LsqSolver::optimise(const ViewGeometry& view, const PositioningParams& para
       double twr2 = 0.0;
       int tn = 0;
       const double trial_cost =
-          accumulate(view, params, points(), use, trial, columns, true, &ta, &tb, &twr2, &tn) +
+          accumulate(view, params, points(), use, trial, columns, true, &ta, &tb, &twr2, &tn,
+                     fit->terms_slot < 0 ? std::span<PointTerms>{} : terms(trial_slot_)) +
           prior_cost(view, params, fit->model, trial, &ta, &tb);
       if (trial_cost <= cost) {
         st = trial;
+        if (fit->terms_slot >= 0) std::swap(fit->terms_slot, trial_slot_);
         cost = trial_cost;
         a = ta;
         b = tb;

@@ -10,6 +10,7 @@
 #include <cmath>
 #include <cstdint>
 #include <span>
+#include <vector>
 
 #include "core/pose.h"
 #include "pipeline/change_of_axes.h"
@@ -64,7 +65,7 @@ struct LsqResult {
 // never allocates. One instance per thread.
 class LsqSolver {
  public:
-  LsqSolver() = default;
+  LsqSolver();
 
   // `use` flags the markers (indices into fixes) to solve from; markers
   // rejected as outliers are cleared in it. Seeds from the fixes' Change of
@@ -99,7 +100,13 @@ class LsqSolver {
     // gather them: a fit's first pass is almost never its last.
     bool want_tilt_columns = false;
     bool tilt_columns = false;
+    // Which of terms_ holds the points' PointTerms at `state` from the pass
+    // that gave `a` (-1: none kept).
+    int terms_slot = -1;
   };
+  std::span<PointTerms> terms(int slot) {
+    return slot < 0 ? std::span<PointTerms>{} : std::span(terms_[static_cast<size_t>(slot)]);
+  }
 
   // The steps of solve(), in order (see lsq_solver.cpp).
   int gather_points(const ViewGeometry& view, const PositioningParams& params,
@@ -109,7 +116,7 @@ class LsqSolver {
                         std::span<const MarkerFix> fixes, const Fit& seed, int* iterations,
                         LsqResult* out);
   void optimise(const ViewGeometry& view, const PositioningParams& params,
-                std::span<const MarkerFix> fixes, Fit* fit, int* iterations) const;
+                std::span<const MarkerFix> fixes, Fit* fit, int* iterations);
   int worst_marker(const ViewGeometry& view, const PositioningParams& params,
                    std::span<const MarkerFix> fixes, const Fit& fit) const;
   bool motion_observable(const ViewGeometry& view, const PositioningParams& params,
@@ -127,6 +134,11 @@ class LsqSolver {
   int point_count_ = 0;
   int edge_points_ = 0;  // of point_count_
   LsqCovariance covariance_;
+  // PointTerms for the covariance, one per point of points_, in three slots:
+  // the held fit's, the free fit's and a trial's, whose slot a fit takes
+  // with the trial (sized once: a solve allocates nothing).
+  std::array<std::vector<PointTerms>, 3> terms_;
+  int trial_slot_ = 2;
 };
 
 }  // namespace ceilpose

@@ -193,8 +193,9 @@ double residual2_px(const ViewGeometry& view, const LsqState& st, const LsqPoint
 double accumulate(const ViewGeometry& view, const PositioningParams& params,
                   std::span<const LsqPoint> points, std::span<const bool> use, const LsqState& st,
                   const LsqModel& model, bool with_jacobian, LsqNormal* a, LsqVector* b,
-                  double* sum_w_r2, int* residuals) {
+                  double* sum_w_r2, int* residuals, std::span<PointTerms> terms) {
   const double k = params.lsq_huber_px;
+  const bool keep = with_jacobian && !terms.empty();
   const PointCamera centre = centre_camera(st);
   // Only the free unknowns' rows and columns: a fit frees 4-6 of the 10, and
   // the update is most of a point's cost.
@@ -206,7 +207,9 @@ double accumulate(const ViewGeometry& view, const PositioningParams& params,
   }
   double cost = 0.0, wr2 = 0.0;
   int n = 0;
-  for (const LsqPoint& pt : points) {
+  for (size_t i = 0; i < points.size(); ++i) {
+    const LsqPoint& pt = points[i];
+    if (keep) terms[i].kept = use[pt.fix];
     if (!use[pt.fix]) continue;
     const PointCamera cam = point_camera(st, pt, centre, with_jacobian);
     double rx = 0.0, ry = 0.0;
@@ -217,7 +220,10 @@ double accumulate(const ViewGeometry& view, const PositioningParams& params,
     wr2 += w * r * r;
     n += pt.residuals();
     if (!with_jacobian) continue;
-    double jx[kN], jy[kN];
+    double own_jx[kN], own_jy[kN];
+    double* jx = keep ? terms[i].jx : own_jx;
+    double* jy = keep ? terms[i].jy : own_jy;
+    if (keep) terms[i].rx = rx, terms[i].ry = ry;
     point_jacobian(view, pt, cam, jx, jy, model.tilt_free(), model.motion_free());
     if (pt.is_edge()) {
       // One residual, across the edge (ry and jy are zero): half the terms.

@@ -2,6 +2,7 @@
 
 #include <gtest/gtest.h>
 
+#include <array>
 #include <cmath>
 
 #include "pipeline/lsq_terms.h"
@@ -50,6 +51,57 @@ TEST(PointJacobian, ColumnsLeftOutAreZeroAndTheOthersUnchanged) {
           }
         }
       }
+    }
+  }
+}
+
+// What accumulate keeps for the covariance at the same state: each point
+// in use, its residual and the Jacobian point_residual and point_jacobian
+// give under the model's columns; a point whose marker is not in use, only
+// that it was not kept. The normal equations are the same with and without.
+TEST(PointTerms, AccumulateKeepsEachPointInUseAsPointResidualAndJacobianGiveIt) {
+  PipelineConfig config;
+  const ViewGeometry view(config);
+  const PositioningParams& params = config.positioning;
+  LsqState st;
+  st.t_w = {2.0, 2.0, 0.3};
+  st.r_wc = {0.0, -1.0, 0.0, 1.0, 0.0, 0.0, 0.0, 0.0, 1.0};
+  st.vx = 0.8, st.vy = -0.3, st.w = 0.6;
+  const PointCamera centre = centre_camera(st);
+  std::array<LsqPoint, 3> points{LsqPoint{0.05, 0.04, {2.1, 2.08, 2.4384}, 0, 0.004},
+                                 LsqPoint{-0.03, 0.02, {1.95, 2.03, 2.4384}, 1, -0.002},
+                                 LsqPoint{0.01, -0.06, {2.02, 1.9, 2.4384}, 0, 0.001}};
+  points[2].normal_x = 0.6, points[2].normal_y = 0.8;
+  const std::array<bool, 2> use{true, false};
+  LsqModel model;
+  model.active = {true, true, true, false, false, false, true, true, true, true};
+  std::array<PointTerms, 3> terms;
+  terms[1].kept = true;  // stale: accumulate must clear it
+  LsqNormal a{}, a_without{};
+  LsqVector b{}, b_without{};
+  double wr2 = 0.0, wr2_without = 0.0;
+  int n = 0, n_without = 0;
+  const double cost =
+      accumulate(view, params, points, use, st, model, true, &a, &b, &wr2, &n, terms);
+  const double cost_without = accumulate(view, params, points, use, st, model, true, &a_without,
+                                         &b_without, &wr2_without, &n_without);
+  EXPECT_EQ(cost, cost_without);
+  EXPECT_EQ(a, a_without);
+  EXPECT_EQ(b, b_without);
+  EXPECT_EQ(n, 3);
+  for (size_t i = 0; i < points.size(); ++i) {
+    EXPECT_EQ(terms[i].kept, use[static_cast<size_t>(points[i].fix)]) << "point " << i;
+    if (!terms[i].kept) continue;
+    const PointCamera cam = point_camera(st, points[i], centre, true);
+    double rx = 0.0, ry = 0.0;
+    ASSERT_TRUE(point_residual(view, points[i], cam, &rx, &ry));
+    double jx[kLsqParams], jy[kLsqParams];
+    point_jacobian(view, points[i], cam, jx, jy, model.tilt_free(), model.motion_free());
+    EXPECT_EQ(terms[i].rx, rx) << "point " << i;
+    EXPECT_EQ(terms[i].ry, ry) << "point " << i;
+    for (int c = 0; c < kLsqParams; ++c) {
+      EXPECT_EQ(terms[i].jx[c], jx[c]) << "point " << i << " column " << c;
+      EXPECT_EQ(terms[i].jy[c], jy[c]) << "point " << i << " column " << c;
     }
   }
 }
