@@ -55,15 +55,25 @@ class MarkerRegion {
     return out;
   }
   // Calls fn(y, x0, x1) for each row from first_row() to last_row() whose
-  // span row(y) is not empty: its x0, and its x1 or one more (truncated
-  // rather than rounded up, for prefetching: docs/pipeline_speed.md,
-  // session 43).
+  // span row(y) is not empty, for prefetching: its x0 or one less, and its
+  // x1 or one more. Truncated rather than rounded up (session 43), and each
+  // bound's columns moved on by its slope a row rather than multiplied out
+  // as columns(y) does, which rounds differently by ~1e-13 px (session 44:
+  // docs/pipeline_speed.md).
   template <typename Fn>
   void for_each_span(Fn fn) const {
     const double width = width_, last_x = width_ - 1.0;
-    for (int y = first_row_; y <= last_row_; ++y) {
-      double lo = 0.0, hi = 0.0;
-      if (!columns(y, &lo, &hi) || !(hi > -1.0) || !(lo < width)) continue;
+    const Bound& a = bounds_[0];
+    const Bound& b = bounds_[1];
+    const double dv = first_row_ - centre_v_px_;
+    double a_lo = centre_u_px_ + (a.lo_px + dv * a.slope);
+    double a_hi = centre_u_px_ + (a.hi_px + dv * a.slope);
+    double b_lo = centre_u_px_ + (b.lo_px + dv * b.slope);
+    double b_hi = centre_u_px_ + (b.hi_px + dv * b.slope);
+    for (int y = first_row_; y <= last_row_;
+         ++y, a_lo += a.slope, a_hi += a.slope, b_lo += b.slope, b_hi += b.slope) {
+      const double lo = std::max(a_lo, b_lo), hi = std::min(a_hi, b_hi);
+      if (!(lo <= hi) || !(hi > -1.0) || !(lo < width)) continue;
       // Both in [0, width − 1]: truncation is the floor.
       const int x0 = static_cast<int>(std::clamp(lo, 0.0, last_x));
       const int x1 = std::min(static_cast<int>(std::clamp(hi, 0.0, last_x)) + 1, width_ - 1);
