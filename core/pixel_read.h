@@ -18,11 +18,11 @@ namespace ceilpose {
 
 // BT.601 limited range (V4L2's default quantisation for YUYV) to RGB,
 // integer: channel = clamp((luma part + the channel's chroma part) >> 8).
-inline int yuv_luma_part(int y) { return 298 * (y - 16) + 128; }
+constexpr int yuv_luma_part(int y) { return 298 * (y - 16) + 128; }
 struct YuvChromaParts {
   int r, g, b;
 };
-inline YuvChromaParts yuv_chroma_parts(int u, int v) {
+constexpr YuvChromaParts yuv_chroma_parts(int u, int v) {
   const int d = u - 128, e = v - 128;
   return {409 * e, -100 * d - 208 * e, 516 * d};
 }

@@ -60,6 +60,46 @@ void add_measures(uint8_t r, uint8_t g, uint8_t b, double w, Brightness* out) {
   (*out)[1] += w * (share[0][r] + share[1][g] + share[2][b]);
 }
 
+// A YUV pixel's channel before yuv_channel's clamp, (luma part + chroma
+// part) >> 8, lies in [kUnclampedMin, kUnclampedMax] for any bytes (the
+// parts' extremes, asserted below). Tables of it hold the clamp: each
+// channel's share of luma at its clamped level, and the clamped level. A
+// pixel's brightest channel is the one of the largest unclamped level
+// (shift and clamp keep order): one clamp a pixel, by table, instead of
+// three and a maximum.
+constexpr int kUnclampedMin = -277, kUnclampedMax = 534;
+constexpr int unclamped_extreme(bool highest) {
+  const int luma = highest ? yuv_luma_part(255) : yuv_luma_part(0);
+  int chroma = 0;
+  for (int u : {0, 255}) {
+    for (int v : {0, 255}) {
+      const YuvChromaParts p = yuv_chroma_parts(u, v);
+      for (int c : {p.r, p.g, p.b}) chroma = highest ? std::max(chroma, c) : std::min(chroma, c);
+    }
+  }
+  return (luma + chroma) >> 8;
+}
+static_assert(unclamped_extreme(false) == kUnclampedMin &&
+              unclamped_extreme(true) == kUnclampedMax);
+constexpr size_t kUnclampedLevels = kUnclampedMax - kUnclampedMin + 1;
+struct UnclampedTables {
+  std::array<std::array<double, kUnclampedLevels>, 3> share;
+  std::array<double, kUnclampedLevels> level;
+};
+const UnclampedTables& unclamped_tables() {
+  static const UnclampedTables tables = [] {
+    UnclampedTables t{};
+    for (int i = kUnclampedMin; i <= kUnclampedMax; ++i) {
+      const size_t k = static_cast<size_t>(i - kUnclampedMin);
+      const auto level = static_cast<size_t>(std::clamp(i, 0, 255));
+      for (size_t c = 0; c < 3; ++c) t.share[c][k] = luma_shares()[c][level];
+      t.level[k] = static_cast<double>(level);
+    }
+    return t;
+  }();
+  return tables;
+}
+
 // The same sum over a YUYV frame's pixels (x0, y0) to (x0 + 1, y0 + 1), in
 // the same order, each pixel's levels as pixel_rgb gives them: a row's two
 // pixels share one chroma pair when x0 is even, so its parts are computed
@@ -68,10 +108,14 @@ void add_measures(uint8_t r, uint8_t g, uint8_t b, double w, Brightness* out) {
 Brightness yuyv_brightness(const ImageView& frame, int x0, int y0, const double (&w)[4]) {
   Brightness out{0.0, 0.0};
   const int pair = x0 >> 1;
+  const UnclampedTables& t = unclamped_tables();
   auto add = [&](int y_level, const YuvChromaParts& p, double weight) {
     const int luma = yuv_luma_part(y_level);
-    add_measures(yuv_channel(luma, p.r), yuv_channel(luma, p.g), yuv_channel(luma, p.b), weight,
-                 &out);
+    const auto r = static_cast<size_t>(((luma + p.r) >> 8) - kUnclampedMin);
+    const auto g = static_cast<size_t>(((luma + p.g) >> 8) - kUnclampedMin);
+    const auto b = static_cast<size_t>(((luma + p.b) >> 8) - kUnclampedMin);
+    out[0] += weight * t.level[std::max({r, g, b})];
+    out[1] += weight * (t.share[0][r] + t.share[1][g] + t.share[2][b]);
   };
   for (int row = 0; row < 2; ++row) {
     const uint8_t* q = frame.row(y0 + row) + kYuyvPairBytes * pair;
