@@ -21,8 +21,7 @@ class LsqCovariance {
   // consistency kept (the solve may have rejected some of them since), `use`:
   // those the solve kept. `terms`: what the accumulate that gave `a` kept
   // of each point at `st` (empty: none; else at least one a point). False
-  // when the normal equations
-  // are singular.
+  // when the normal equations are singular.
   bool robot_covariance(const ViewGeometry& view, const PositioningParams& params,
                         const LsqModel& model, std::span<const LsqPoint> points,
                         std::span<const PointTerms> terms, std::span<const MarkerFix> fixes,
